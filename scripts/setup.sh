@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Set up everything hilldem needs on a fresh Debian 12 machine, then configure and build it.
+# Idempotent: packages already present are skipped, and the build is incremental.
+#   scripts/setup.sh [build-dir]        (default: build)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build_dir="${1:-build}"
+
+# Debian packages and why each is here:
+#   g++, cmake, make      the compiler and build system
+#   libtomlplusplus-dev   TOML parser for scenario files (line/column in syntax errors)
+#   libcli11-dev          command-line parsing (subcommands, typed options, --help)
+#   libfmt-dev            number formatting for tables and CSV
+#   libgtest-dev          GoogleTest, the test framework (run through CTest)
+packages=(g++ cmake make libtomlplusplus-dev libcli11-dev libfmt-dev libgtest-dev)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing ${missing[*]}"
+  sudo_cmd=""
+  [ "$(id -u)" -ne 0 ] && sudo_cmd="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $sudo_cmd apt-get install -y -q "${missing[@]}" >/dev/null 2>&1 || {
+    $sudo_cmd apt-get update -q >/dev/null
+    $sudo_cmd apt-get install -y -q "${missing[@]}"
+  }
+fi
+
+cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build "$build_dir" -j"$(nproc)"

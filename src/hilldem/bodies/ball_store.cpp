@@ -1,0 +1,64 @@
+#include "hilldem/bodies/ball_store.hpp"
+
+#include <numbers>
+
+#include "hilldem/core/error.hpp"
+
+namespace hilldem {
+
+std::size_t BallStore::add(const BallInit& b) {
+  id.push_back(b.id);
+  radius.push_back(b.radius);
+  density.push_back(b.density);
+  mass.push_back(0.0);
+  inertia.push_back(0.0);
+  young_mod.push_back(b.young_mod);
+  pois_ratio.push_back(b.pois_ratio);
+  groups.push_back(b.groups);
+  fixity.push_back(b.fixity);
+  position.push_back(b.position);
+  velocity.push_back(b.velocity);
+  spin.push_back(b.spin);
+  contact_force.emplace_back();
+  contact_moment.emplace_back();
+  applied_force.emplace_back();
+  applied_moment.emplace_back();
+  const std::size_t i = size() - 1;
+  update_mass(i);
+  return i;
+}
+
+long BallStore::find(std::int64_t user_id) const {
+  for (std::size_t i = 0; i < id.size(); ++i)
+    if (id[i] == user_id) return static_cast<long>(i);
+  return -1;
+}
+
+void BallStore::update_mass(std::size_t i) {
+  const double r = radius[i];
+  mass[i] = 4.0 / 3.0 * std::numbers::pi * r * r * r * density[i];
+  inertia[i] = 0.4 * mass[i] * r * r;  // solid sphere
+}
+
+std::uint64_t GroupNames::bit(const std::string& name) {
+  if (const auto b = find(name)) return b;
+  if (names_.size() >= 64)
+    throw InputError("too many group names (at most 64): cannot add group '" + name + "'");
+  names_.push_back(name);
+  return std::uint64_t{1} << (names_.size() - 1);
+}
+
+std::uint64_t GroupNames::find(const std::string& name) const {
+  for (std::size_t k = 0; k < names_.size(); ++k)
+    if (names_[k] == name) return std::uint64_t{1} << k;
+  return 0;
+}
+
+std::string GroupNames::describe(std::uint64_t mask) const {
+  std::string out;
+  for (std::size_t k = 0; k < names_.size(); ++k)
+    if (mask & (std::uint64_t{1} << k)) out += (out.empty() ? "" : ",") + names_[k];
+  return out.empty() ? "-" : out;
+}
+
+}  // namespace hilldem

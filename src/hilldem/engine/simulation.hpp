@@ -1,0 +1,103 @@
+// Simulation: owns the stores, the assignment table and the clock, and runs the cycle of spec §1.2:
+//   1. velocities to t+Δt/2 from the forces at t (local damping, gravity, fixity),
+//   2. positions to t+Δt, walls moved by their imposed motion,
+//   3. contact detection and resolution at the new positions (history kept by a sorted merge),
+//   4. force-displacement law of every contact -> forces at t+Δt, summed per body in a fixed order.
+// Lab-test drivers and the scenario runner use only this public API.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "hilldem/bodies/ball_store.hpp"
+#include "hilldem/bodies/wall_store.hpp"
+#include "hilldem/contact/contact_store.hpp"
+#include "hilldem/models/model_table.hpp"
+#include "hilldem/motion/law_of_motion.hpp"
+
+namespace hilldem {
+
+struct SimulationSettings {
+  Vec3 gravity;                  // [m/s²]
+  double local_damping = 0.0;    // α [-], [0, 1)
+  bool auto_timestep = true;     // Δt from the stiffness estimate (spec §4) or fixed
+  double timestep = 1e-6;        // [s] fixed Δt (when auto_timestep is false)
+  double timestep_safety = 0.8;  // f [-], Δt = f Δt_crit
+  double timestep_max = 1e-4;    // [s] Δt used when no contact reports a stiffness yet
+  double proximity = 0.0;        // [m] contacts are created for gaps ≤ proximity
+};
+
+// Geometry of a contact at the current positions.
+struct ContactGeometry {
+  Vec3 normal;        // n̂_c, piece 1 -> piece 2
+  double gap = 0.0;   // g_c [m]
+  Vec3 point;         // x_c [m]
+  bool valid = true;  // false: a ball beyond a cylinder's end (no contact possible)
+};
+
+class Simulation {
+ public:
+  BallStore balls;
+  WallStore walls;
+  ContactStore contacts;
+  ModelTable table;
+  GroupNames groups;
+  SimulationSettings settings;
+
+  double time = 0.0;        // [s]
+  std::int64_t steps = 0;   // cycles done
+  double last_dt = 0.0;     // [s] Δt of the last cycle
+
+  // Called after every cycle (histories, progress).
+  std::vector<std::function<void(const Simulation&)>> observers;
+
+  // Run n cycles.
+  void cycle(std::int64_t n);
+  // Cycle (at least once) until the mean unbalanced-force ratio is ≤ ratio; returns the cycles
+  // used, or -1 if max_steps passed first.
+  std::int64_t solve(double ratio, std::int64_t max_steps);
+
+  // Δt the next cycle will use [s].
+  double next_timestep() const;
+  // f·Δt_crit from the contact stiffnesses (spec §4, hill Eqs. 19-21), or 0 if no contact reports one.
+  double estimate_timestep() const;
+  // Mean unbalanced force over free balls / mean contact force over active contacts [-]; a contact's
+  // force counts as |F^s_n n̂ + F_s| + |F^m|.
+  double mean_unbalanced_ratio() const;
+
+  // Material-level wetting (spec §2.7): contacts for every ball pair within gap [m] (new ones
+  // included), suction [Pa] on their hill contacts, make_wet(gap) on every hill contact. Returns the
+  // number of wet contacts after the call.
+  std::size_t make_wet(double suction, double gap);
+  // make_dry on every hill contact; returns how many were wet.
+  std::size_t make_dry();
+
+  // Recompute every contact's mapping (after properties of bodies or contacts changed).
+  void refresh_mappings();
+  // Forces are recomputed (without any shear increment) before the next cycle: call after moving
+  // bodies by hand.
+  void invalidate_forces() { forces_ready_ = false; }
+  // Detect contacts and compute forces at the current state with no motion (Δt = 0 increments).
+  void update_forces();
+
+  ContactGeometry geometry(std::size_t c) const;
+  // Contact between balls with user ids, or between a ball and a wall (index); -1 if none.
+  long find_ball_ball(std::int64_t id1, std::int64_t id2) const;
+  long find_ball_wall(std::int64_t ball_id, std::size_t wall) const;
+  // Candidate pairs that matched no assignment rule at the last detection.
+  std::size_t unassigned_pairs() const { return unassigned_pairs_; }
+
+ private:
+  void step_once();
+  void detect(double proximity);
+  void force_pass(double dt);
+  void compute_mapping(ContactStore& store, std::size_t c) const;
+  std::uint64_t piece2_groups(const ContactKey& k) const;
+
+  bool forces_ready_ = false;
+  std::size_t unassigned_pairs_ = 0;
+};
+
+}  // namespace hilldem

@@ -1,0 +1,459 @@
+#include "hilldem/io/scenario.hpp"
+
+#include <fmt/format.h>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "hilldem/core/error.hpp"
+
+namespace hilldem {
+
+const char* to_string(StageType t) {
+  switch (t) {
+    case StageType::Cycle: return "cycle";
+    case StageType::Solve: return "solve";
+    case StageType::Translate: return "translate";
+    case StageType::Rotate: return "rotate";
+    case StageType::Set: return "set";
+    case StageType::SetContacts: return "set_contacts";
+    case StageType::SetSimulation: return "set_simulation";
+    case StageType::MakeWet: return "make_wet";
+    case StageType::MakeDry: return "make_dry";
+    case StageType::Probe: return "probe";
+    case StageType::ListContacts: return "list_contacts";
+  }
+  return "?";
+}
+
+namespace {
+
+constexpr double kInf = HUGE_VAL;
+const Range kPoisson = Range::open_closed(-1.0, 0.5);    // spec §2.2
+const Range kDampCon = Range::closed_open(0.0, 1.0);      // spec §2.2
+const Range kLocalDamping = Range::closed_open(0.0, 1.0);
+
+struct Material {
+  double density, young_mod, pois_ratio;
+};
+
+FixityMask read_fixity(TableReader& t, const std::string& key) {
+  FixityMask m = 0;
+  for (const std::string& s : t.strings(key)) {
+    if (s == "x") m |= 1;
+    else if (s == "y") m |= 2;
+    else if (s == "z") m |= 4;
+    else if (s == "spin_x") m |= 8;
+    else if (s == "spin_y") m |= 16;
+    else if (s == "spin_z") m |= 32;
+    else if (s == "velocity") m |= kFixVel;
+    else if (s == "spin") m |= kFixSpin;
+    else if (s == "all") m |= kFixAll;
+    else
+      t.fail(key, "unknown component \"" + s +
+                      "\"; allowed: \"x\", \"y\", \"z\", \"spin_x\", \"spin_y\", \"spin_z\", \"velocity\", \"spin\", \"all\"");
+  }
+  return m;
+}
+
+std::uint64_t read_groups(TableReader& t, GroupNames& names) {
+  std::uint64_t mask = 0;
+  for (const std::string& g : t.strings("groups")) {
+    if (g.empty()) t.fail("groups", "group names must not be empty");
+    mask |= names.bit(g);
+  }
+  return mask;
+}
+
+class Reader {
+ public:
+  Reader(const toml::table& root, std::string file) : root_(root, file, ""), file_(std::move(file)) {}
+
+  Scenario read() {
+    Scenario sc;
+    sc.file = file_;
+    sc.title = root_.string("title", "");
+    read_simulation(sc);
+    read_output(sc);
+    for (TableReader& t : root_.tables("material")) read_material(t);
+    for (TableReader& t : root_.tables("ball")) read_ball(t, sc.sim);
+    for (TableReader& t : root_.tables("ball_grid")) read_ball_grid(t, sc.sim);
+    for (TableReader& t : root_.tables("wall")) read_wall(t, sc.sim);
+    for (TableReader& t : root_.tables("contact_model")) read_rule(t, sc.sim);
+    for (TableReader& t : root_.tables("history")) read_history(t, sc);
+    for (TableReader& t : root_.tables("stage")) read_stage(t, sc);
+    root_.finish();
+    return sc;
+  }
+
+ private:
+  void read_simulation(Scenario& sc) {
+    SimulationSettings& s = sc.sim.settings;
+    auto t = root_.table("simulation");
+    if (!t) return;
+    s.gravity = t->vec3("gravity", Vec3{}, Range::any(), "[m/s^2]");
+    s.local_damping = t->real("local_damping", 0.0, kLocalDamping, "[-]");
+    if (t->has("timestep") && t->is_string("timestep")) {
+      t->choice("timestep", std::nullopt, {"auto"});
+      s.auto_timestep = true;
+    } else if (t->has("timestep")) {
+      s.auto_timestep = false;
+      s.timestep = t->real("timestep", std::nullopt, Range::open(0.0, 1.0), "[s] (or \"auto\")");
+    }
+    s.timestep_safety = t->real("timestep_safety", 0.8, Range::open_closed(0.0, 1.0), "[-]");
+    s.timestep_max = t->real("timestep_max", 1e-4, Range::open(0.0, 1.0), "[s]");
+    s.proximity = t->real("proximity", 0.0, Range::closed(0.0, kInf), "[m]");
+    t->finish();
+  }
+
+  void read_output(Scenario& sc) {
+    auto t = root_.table("output");
+    if (!t) return;
+    sc.output_dir = t->string("dir", "");
+    sc.history_every = t->integer("history_every", 1, 1, INT64_MAX);
+    sc.history_file = t->string("history_file", "history.csv");
+    if (sc.history_file.empty() || sc.history_file.find('/') != std::string::npos)
+      t->fail("history_file", "must be a plain file name (no '/')");
+    t->finish();
+  }
+
+  void read_material(TableReader& t) {
+    const std::string name = t.string("name", std::nullopt);
+    if (materials_.count(name)) t.fail("name", "material \"" + name + "\" is defined twice");
+    Material m;
+    m.density = t.real("density", std::nullopt, Range::positive(), "[kg/m^3]");
+    m.young_mod = t.real("young_mod", 0.0, Range::closed(0.0, kInf), "[Pa]");
+    m.pois_ratio = t.real("pois_ratio", 0.0, kPoisson, "[-]");
+    t.finish();
+    materials_[name] = m;
+  }
+
+  const Material& material(TableReader& t) {
+    std::string known;
+    for (const auto& [k, v] : materials_) known += (known.empty() ? "" : ", ") + k;
+    const std::string name = t.string("material", std::nullopt);
+    const auto it = materials_.find(name);
+    if (it == materials_.end())
+      t.fail("material", "no [[material]] named \"" + name + "\"; defined: " + (known.empty() ? "(none)" : known));
+    return it->second;
+  }
+
+  BallInit common_ball(TableReader& t, Simulation& sim) {
+    BallInit b;
+    const Material& m = material(t);
+    b.density = m.density;
+    b.young_mod = m.young_mod;
+    b.pois_ratio = m.pois_ratio;
+    b.radius = t.real("radius", std::nullopt, Range::positive(), "[m]");
+    b.groups = read_groups(t, sim.groups);
+    b.fixity = read_fixity(t, "fix");
+    b.velocity = t.vec3("velocity", Vec3{}, Range::any(), "[m/s]");
+    b.spin = t.vec3("spin", Vec3{}, Range::any(), "[rad/s]");
+    return b;
+  }
+
+  void add_ball(TableReader& t, Simulation& sim, const BallInit& b) {
+    if (!ids_.insert(b.id).second) t.fail("id", "ball id " + std::to_string(b.id) + " is used twice");
+    sim.balls.add(b);
+  }
+
+  void read_ball(TableReader& t, Simulation& sim) {
+    BallInit b = common_ball(t, sim);
+    b.id = t.integer("id", std::nullopt, 0, INT64_MAX);
+    b.position = t.vec3("position", std::nullopt, Range::any(), "[m]");
+    t.finish();
+    add_ball(t, sim, b);
+  }
+
+  void read_ball_grid(TableReader& t, Simulation& sim) {
+    BallInit b = common_ball(t, sim);
+    std::int64_t id = t.integer("first_id", std::nullopt, 0, INT64_MAX);
+    const Vec3 origin = t.vec3("origin", std::nullopt, Range::any(), "[m]");
+    const Vec3 counts = t.vec3("counts", std::nullopt, Range::closed(1, 1000), "[-]");
+    const double spacing = t.real("spacing", std::nullopt, Range::positive(), "[m]");
+    t.finish();
+    for (int k = 0; k < static_cast<int>(counts.z); ++k)
+      for (int j = 0; j < static_cast<int>(counts.y); ++j)
+        for (int i = 0; i < static_cast<int>(counts.x); ++i) {
+          b.id = id++;
+          b.position = origin + Vec3{i * spacing, j * spacing, k * spacing};
+          add_ball(t, sim, b);
+        }
+  }
+
+  void motion_keys(TableReader& t, Wall& w) {
+    w.velocity = t.vec3("velocity", Vec3{}, Range::any(), "[m/s]");
+    w.spin = t.vec3("spin", Vec3{}, Range::any(), "[rad/s]");
+  }
+
+  void read_wall(TableReader& t, Simulation& sim) {
+    Wall w;
+    w.name = t.string("name", std::nullopt);
+    if (w.name.empty()) t.fail("name", "must not be empty");
+    if (!wall_names_.insert(w.name).second) t.fail("name", "wall \"" + w.name + "\" is defined twice");
+    w.groups = read_groups(t, sim.groups);
+    const std::string type = t.choice("type", std::nullopt, {"plane", "facet", "cylinder", "box"});
+    if (type == "plane") {
+      w.shape = WallShape::Plane;
+      w.point = t.vec3("point", std::nullopt, Range::any(), "[m]");
+      const Vec3 n = t.vec3("normal", std::nullopt, Range::any(), "[-]");
+      if (norm(n) == 0.0) t.fail("normal", "must not be the zero vector");
+      w.normal = n / norm(n);
+      w.rotation_center = t.vec3("rotation_center", w.point, Range::any(), "[m]");
+      motion_keys(t, w);
+    } else if (type == "facet") {
+      w.shape = WallShape::Facet;
+      const auto v = t.vec3_list("vertices", "[m]");
+      if (v.size() != 3) t.fail("vertices", "a facet needs exactly 3 vertices");
+      if (norm(cross(v[1] - v[0], v[2] - v[0])) == 0.0) t.fail("vertices", "the 3 vertices are collinear");
+      for (int k = 0; k < 3; ++k) w.vertex[k] = v[k];
+      w.rotation_center = t.vec3("rotation_center", (v[0] + v[1] + v[2]) / 3.0, Range::any(), "[m]");
+      motion_keys(t, w);
+    } else if (type == "cylinder") {
+      w.shape = WallShape::Cylinder;
+      const std::string axis = t.choice("axis", "z", {"x", "y", "z"});
+      w.axis = axis[0] - 'x';
+      w.point = t.vec3("center", std::nullopt, Range::any(), "[m]");
+      w.radius = t.real("radius", std::nullopt, Range::positive(), "[m]");
+      if (t.has("extent")) {
+        const auto e = t.reals("extent", Range::any(), "[m]");
+        if (e.size() != 2 || !(e[0] < e[1]))
+          t.fail("extent", "must be [lo, hi] with lo < hi [m], along the axis from the center");
+        w.lo = e[0];
+        w.hi = e[1];
+      }
+      w.rotation_center = w.point;
+      w.velocity = t.vec3("velocity", Vec3{}, Range::any(), "[m/s]");
+      w.radial_velocity = t.real("radial_velocity", 0.0, Range::any(), "[m/s]");
+    } else {
+      read_box(t, sim, w);
+      return;
+    }
+    t.finish();
+    sim.walls.add(w);
+  }
+
+  // A box of 12 facets (2 per face) named <name>.<face>.<1|2>, each in the groups <name> and
+  // <name>.<face> (faces xmin, xmax, ymin, ymax, zmin, zmax), so `wall = "box.zmin"` sums the floor.
+  void read_box(TableReader& t, Simulation& sim, const Wall& base) {
+    const Vec3 lo = t.vec3("min", std::nullopt, Range::any(), "[m]");
+    const Vec3 hi = t.vec3("max", std::nullopt, Range::any(), "[m]");
+    if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z)) t.fail("max", "must exceed min in x, y and z");
+    t.finish();
+    const char* faces[6] = {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
+    for (int f = 0; f < 6; ++f) {
+      const int axis = f / 2;
+      const double at = f % 2 ? hi[axis] : lo[axis];
+      const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+      Vec3 c[4];
+      for (int k = 0; k < 4; ++k) {
+        c[k][axis] = at;
+        c[k][u] = (k == 1 || k == 2) ? hi[u] : lo[u];
+        c[k][v] = (k >= 2) ? hi[v] : lo[v];
+      }
+      const std::string face = base.name + "." + faces[f];
+      for (int half = 0; half < 2; ++half) {
+        Wall w = base;
+        w.shape = WallShape::Facet;
+        w.name = face + "." + std::to_string(half + 1);
+        w.groups = base.groups | sim.groups.bit(base.name) | sim.groups.bit(face);
+        w.vertex[0] = c[0];
+        w.vertex[1] = half == 0 ? c[1] : c[2];
+        w.vertex[2] = half == 0 ? c[2] : c[3];
+        w.rotation_center = (lo + hi) / 2.0;
+        sim.walls.add(w);
+      }
+    }
+  }
+
+  std::uint64_t group_filter(TableReader& t, const std::string& g, Simulation& sim, const std::string& key) {
+    if (g == "any") return 0;
+    const std::uint64_t bit = sim.groups.find(g);
+    if (!bit) t.fail(key, "no ball or wall is in group \"" + g + "\"");
+    return bit;
+  }
+
+  void read_rule(TableReader& t, Simulation& sim) {
+    ModelRule r;
+    r.name = t.string("name", "rule " + std::to_string(sim.table.rules.size() + 1));
+    const std::string between = t.choice("between", std::nullopt, {"ball-ball", "ball-wall"});
+    r.kind = between == "ball-ball" ? ContactKind::BallBall : ContactKind::BallWall;
+    const auto groups = t.strings("groups");
+    if (groups.size() > 2) t.fail("groups", "at most two group names: [\"ball group\", \"other group\"]");
+    if (groups.size() >= 1) {
+      r.groups1_text = groups[0];
+      r.groups1 = group_filter(t, groups[0], sim, "groups");
+    }
+    if (groups.size() == 2) {
+      r.groups2_text = groups[1];
+      r.groups2 = group_filter(t, groups[1], sim, "groups");
+    }
+    const std::string model = t.choice("model", std::nullopt, {"linear", "hill"});
+    if (model == "hill") {
+      if (r.kind != ContactKind::BallBall)
+        t.fail("model", "the hill model exists only between grains (ball-ball); use \"linear\" for ball-wall (spec §2.1)");
+      r.model = ModelKind::Hill;
+      r.hill.fric_coef = t.real("fric_coef", 0.0, Range::closed(0.0, kInf), "[-]");
+      r.hill.damp_con = t.real("damp_con", 0.0, kDampCon, "[-]");
+      r.hill.suction = t.real("suction", 0.0, Range::closed(0.0, kInf), "[Pa]");
+    } else {
+      r.model = ModelKind::Linear;
+      r.linear.emod = t.real("emod", std::nullopt, Range::positive(), "[Pa]");
+      r.linear.kratio = t.real("kratio", 1.0, Range::positive(), "[-]");
+      r.linear.fric = t.real("fric", 0.0, Range::closed(0.0, kInf), "[-]");
+    }
+    t.finish();
+    sim.table.rules.push_back(r);
+  }
+
+  void read_history(TableReader& t, Scenario& sc) {
+    History h;
+    h.name = t.string("name", std::nullopt);
+    if (h.name.empty() || h.name.find_first_of(",\"\n") != std::string::npos)
+      t.fail("name", "must be a non-empty name without commas, quotes or newlines");
+    for (const History& o : sc.histories)
+      if (o.name == h.name) t.fail("name", "history \"" + h.name + "\" is defined twice");
+    h.quantity = read_quantity(t, sc.sim);
+    t.finish();
+    sc.histories.push_back(h);
+  }
+
+  Selection read_selection(TableReader& t, const Simulation& sim, bool walls_allowed) {
+    Selection s;
+    const int given = t.has("ball") + t.has("balls") + t.has("group") + (walls_allowed && t.has("wall"));
+    const std::string keys = walls_allowed ? "ball, balls, group or wall" : "ball, balls or group";
+    if (given != 1) t.fail(given ? "ball" : "type", "needs exactly one of the keys " + keys);
+    if (t.has("ball") || t.has("balls")) {
+      const auto ids = t.has("ball") ? t.integers("ball") : t.integers("balls");
+      for (std::int64_t id : ids) {
+        const long i = sim.balls.find(id);
+        if (i < 0) t.fail(t.has("ball") ? "ball" : "balls", "no ball with id " + std::to_string(id));
+        s.balls.push_back(static_cast<std::size_t>(i));
+      }
+      if (s.balls.empty()) t.fail("balls", "must list at least one ball id");
+      s.text = "ball(s) " + fmt::format("{}", fmt::join(ids, ","));
+    } else if (t.has("group")) {
+      const std::string g = t.string("group", std::nullopt);
+      const std::uint64_t bit = sim.groups.find(g);
+      for (std::size_t i = 0; i < sim.balls.size(); ++i)
+        if (bit && (sim.balls.groups[i] & bit)) s.balls.push_back(i);
+      if (s.balls.empty()) t.fail("group", "no ball is in group \"" + g + "\"");
+      s.text = "group " + g;
+    } else {
+      const std::string w = t.string("wall", std::nullopt);
+      const std::uint64_t bit = sim.groups.find(w);
+      for (std::size_t k = 0; k < sim.walls.size(); ++k)
+        if (sim.walls.walls[k].name == w || (bit && (sim.walls.walls[k].groups & bit))) s.walls.push_back(k);
+      if (s.walls.empty()) t.fail("wall", "no wall named or grouped \"" + w + "\"");
+      s.text = "wall " + w;
+    }
+    return s;
+  }
+
+  void read_stage(TableReader& t, Scenario& sc) {
+    Stage s;
+    const std::string type = t.choice("type", std::nullopt,
+                                      {"cycle", "solve", "translate", "rotate", "set", "set_contacts",
+                                       "set_simulation", "make_wet", "make_dry", "probe", "list_contacts"});
+    s.name = t.string("name", type);
+    const Simulation& sim = sc.sim;
+    if (type == "cycle") {
+      s.type = StageType::Cycle;
+      s.steps = t.integer("steps", std::nullopt, 1, 1'000'000'000'000);
+    } else if (type == "solve") {
+      s.type = StageType::Solve;
+      s.ratio = t.real("ratio", 1e-5, Range::open(0.0, 1.0), "[-]");
+      s.max_steps = t.integer("max_steps", 1'000'000, 1, 1'000'000'000'000);
+    } else if (type == "translate" || type == "rotate") {
+      s.type = type == "translate" ? StageType::Translate : StageType::Rotate;
+      s.sel = read_selection(t, sim, false);
+      s.by = t.vec3("by", std::nullopt, Range::any(), type == "translate" ? "[m]" : "[rad] (rotation vector)");
+      s.steps = t.integer("steps", std::nullopt, 1, 1'000'000'000);
+    } else if (type == "set") {
+      s.type = StageType::Set;
+      s.sel = read_selection(t, sim, true);
+      const bool walls = !s.sel.walls.empty();
+      if (t.has("velocity")) s.velocity = t.vec3("velocity", std::nullopt, Range::any(), "[m/s]");
+      if (t.has("spin")) s.spin = t.vec3("spin", std::nullopt, Range::any(), "[rad/s]");
+      if (walls) {
+        if (t.has("radial_velocity"))
+          s.radial_velocity = t.real("radial_velocity", std::nullopt, Range::any(), "[m/s]");
+      } else {
+        if (t.has("position")) s.position = t.vec3("position", std::nullopt, Range::any(), "[m]");
+        if (t.has("applied_force")) s.applied_force = t.vec3("applied_force", std::nullopt, Range::any(), "[N]");
+        s.fix = read_fixity(t, "fix");
+        s.free = read_fixity(t, "free");
+        if (s.fix & s.free) t.fail("free", "a component cannot be fixed and freed in the same stage");
+      }
+    } else if (type == "set_contacts") {
+      s.type = StageType::SetContacts;
+      const std::string m = t.choice("model", std::nullopt, {"linear", "hill"});
+      s.model_filter = m == "hill" ? ModelKind::Hill : ModelKind::Linear;
+      if (m == "hill") {
+        if (t.has("fric_coef")) s.fric = t.real("fric_coef", std::nullopt, Range::closed(0.0, kInf), "[-]");
+        if (t.has("damp_con")) s.damp_con = t.real("damp_con", std::nullopt, kDampCon, "[-]");
+        if (t.has("suction")) s.suction = t.real("suction", std::nullopt, Range::closed(0.0, kInf), "[Pa]");
+      } else {
+        if (t.has("fric")) s.fric = t.real("fric", std::nullopt, Range::closed(0.0, kInf), "[-]");
+        if (t.has("emod")) s.emod = t.real("emod", std::nullopt, Range::positive(), "[Pa]");
+        if (t.has("kratio")) s.kratio = t.real("kratio", std::nullopt, Range::positive(), "[-]");
+      }
+    } else if (type == "set_simulation") {
+      s.type = StageType::SetSimulation;
+      if (t.has("gravity")) s.gravity = t.vec3("gravity", std::nullopt, Range::any(), "[m/s^2]");
+      if (t.has("local_damping")) s.local_damping = t.real("local_damping", std::nullopt, kLocalDamping, "[-]");
+      if (t.has("timestep")) {
+        if (t.is_string("timestep")) {
+          t.choice("timestep", std::nullopt, {"auto"});
+          s.timestep = 0.0;
+        } else {
+          s.timestep = t.real("timestep", std::nullopt, Range::open(0.0, 1.0), "[s] (or \"auto\")");
+        }
+      }
+    } else if (type == "make_wet") {
+      s.type = StageType::MakeWet;
+      s.wet_suction = t.real("suction", std::nullopt, Range::closed(0.0, kInf), "[Pa]");
+      s.wet_gap = t.real("gap", std::nullopt, Range::closed(0.0, kInf), "[m]");
+    } else if (type == "make_dry") {
+      s.type = StageType::MakeDry;
+    } else if (type == "probe") {
+      s.type = StageType::Probe;
+      s.label = t.string("label", std::nullopt);
+      if (s.label.empty()) t.fail("label", "must not be empty");
+      if (!labels_.insert(s.label).second) t.fail("label", "probe label \"" + s.label + "\" is used twice");
+      s.quantity = read_quantity(t, sim);
+      s.ratio_to = t.string("ratio_to", "");
+      if (!s.ratio_to.empty() && (s.ratio_to == s.label || !labels_.count(s.ratio_to)))
+        t.fail("ratio_to", "must name an earlier probe label; got \"" + s.ratio_to + "\"");
+      s.scale = t.real("scale", 1.0, Range::any(), "[-]");
+    } else {
+      s.type = StageType::ListContacts;
+    }
+    t.finish();
+    sc.stages.push_back(std::move(s));
+  }
+
+  TableReader root_;
+  std::string file_;
+  std::map<std::string, Material> materials_;
+  std::set<std::int64_t> ids_;
+  std::set<std::string> wall_names_, labels_;
+};
+
+}  // namespace
+
+Scenario load_scenario(const std::string& text, const std::string& file) {
+  const toml::table root = parse_toml(text, file);
+  return Reader(root, file).read();
+}
+
+Scenario load_scenario_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open the scenario file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return load_scenario(ss.str(), path);
+}
+
+}  // namespace hilldem
