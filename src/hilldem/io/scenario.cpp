@@ -356,7 +356,7 @@ class Reader {
     const std::string type = t.choice("type", std::nullopt,
                                       {"cycle", "solve", "translate", "rotate", "set", "set_contacts",
                                        "set_simulation", "make_wet", "make_dry", "probe", "list_contacts"});
-    s.name = t.string("name", type);
+    s.name = t.string("name", type == "probe" && t.is_string("label") ? *t.peek_string("label") : type);
     const Simulation& sim = sc.sim;
     if (type == "cycle") {
       s.type = StageType::Cycle;

@@ -37,6 +37,11 @@ class TableReader {
 
   bool has(const std::string& key) const;
   bool is_string(const std::string& key) const;  // present and a string
+  // The string at key without marking it as read (nullopt if absent or not a string).
+  std::optional<std::string> peek_string(const std::string& key) const {
+    const toml::node* n = table_->get(key);
+    return n && n->is_string() ? std::optional<std::string>(*n->value<std::string>()) : std::nullopt;
+  }
   std::vector<double> reals(const std::string& key, Range range, const char* unit);  // absent: empty
   // Required when no default is given.
   double real(const std::string& key, std::optional<double> def, Range range, const char* unit);

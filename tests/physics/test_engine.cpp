@@ -1,0 +1,210 @@
+// Engine behaviour: make_wet creates contacts, wet contacts persist at positive gaps, the cycle's
+// order and integrator, fixity, the automatic time step, Appendix A through the engine, determinism.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "hilldem/io/runner.hpp"
+#include "hilldem/io/scenario.hpp"
+#include "sim_builders.hpp"
+
+namespace hilldem {
+namespace {
+
+using namespace hilldem::testing;
+
+// Three balls in a row with gaps 1 mm and 3 mm; no contacts exist before make_wet.
+Simulation three_in_a_row() {
+  Simulation sim;
+  const double r = 5e-3;
+  sim.balls.add(granite(1, {0, 0, 0}, r));
+  sim.balls.add(granite(2, {2 * r + 1e-3, 0, 0}, r));
+  sim.balls.add(granite(3, {4 * r + 4e-3, 0, 0}, r));
+  sim.table.rules.push_back(hill_rule(0.4, 0.0));
+  sim.settings.auto_timestep = false;
+  sim.settings.timestep = 1e-6;
+  return sim;
+}
+
+TEST(MakeWet, CreatesContactsWithinTheGapOnly) {
+  Simulation sim = three_in_a_row();
+  sim.update_forces();
+  EXPECT_EQ(sim.contacts.size(), 0u);
+  EXPECT_EQ(sim.make_wet(200e3, 2e-3), 1u);
+  ASSERT_EQ(sim.contacts.size(), 1u);
+  EXPECT_GE(sim.find_ball_ball(1, 2), 0);
+  EXPECT_LT(sim.find_ball_ball(2, 3), 0);
+  EXPECT_EQ(sim.contacts.moisture[0], Moisture::Wet);
+  EXPECT_DOUBLE_EQ(sim.contacts.hill_params[0].suction, 200e3);
+  // Wider gap: both pairs.
+  EXPECT_EQ(sim.make_wet(100e3, 3.5e-3), 2u);
+}
+
+TEST(MakeWet, WetContactSurvivesPositiveGapAndPullsTheGrains) {
+  Simulation sim = three_in_a_row();
+  sim.make_wet(200e3, 2e-3);
+  sim.cycle(10);
+  const long c = sim.find_ball_ball(1, 2);
+  ASSERT_GE(c, 0);
+  EXPECT_TRUE(sim.contacts.active[c]);
+  EXPECT_LT(sim.contacts.moisture_force[c], 0.0);
+  EXPECT_GT(sim.balls.velocity[0].x, 0.0);  // ball 1 pulled towards ball 2
+  EXPECT_LT(sim.balls.velocity[1].x, 0.0);
+}
+
+TEST(MakeDry, DriedOpenContactIsDeleted) {
+  Simulation sim = three_in_a_row();
+  sim.make_wet(200e3, 2e-3);
+  sim.cycle(1);
+  EXPECT_EQ(sim.make_dry(), 1u);
+  sim.cycle(1);
+  EXPECT_EQ(sim.contacts.size(), 0u);
+}
+
+// Spec §4: velocities at half steps; a free ball under gravity follows the central-difference
+// recurrence exactly: v_n = n g Δt, z_n = z_0 + g Δt² n(n+1)/2.
+TEST(LawOfMotion, FreeFallMatchesCentralDifference) {
+  Simulation sim;
+  sim.balls.add(granite(1, {0, 0, 1.0}, 5e-3));
+  sim.settings.gravity = {0, 0, -9.81};
+  sim.settings.auto_timestep = false;
+  sim.settings.timestep = 1e-3;
+  sim.cycle(100);
+  EXPECT_NEAR(sim.balls.velocity[0].z, -9.81 * 100 * 1e-3, 1e-12);
+  EXPECT_NEAR(sim.balls.position[0].z, 1.0 - 9.81 * 1e-6 * 100 * 101 / 2, 1e-12);
+  EXPECT_NEAR(sim.time, 0.1, 1e-12);
+}
+
+TEST(LawOfMotion, FixedComponentsKeepTheirVelocity) {
+  Simulation sim;
+  BallInit b = granite(1, {0, 0, 0}, 5e-3, {0.1, 0, 0});
+  b.fixity = 0b000101;  // x and z fixed
+  sim.balls.add(b);
+  sim.settings.gravity = {0, -9.81, -9.81};
+  sim.settings.auto_timestep = false;
+  sim.settings.timestep = 1e-3;
+  sim.cycle(10);
+  EXPECT_DOUBLE_EQ(sim.balls.velocity[0].x, 0.1);
+  EXPECT_DOUBLE_EQ(sim.balls.velocity[0].z, 0.0);
+  EXPECT_NEAR(sim.balls.velocity[0].y, -9.81e-2, 1e-12);
+  EXPECT_NEAR(sim.balls.position[0].x, 1e-3, 1e-15);
+}
+
+// Local damping with α = 0.7 brings a ball resting on a plane to equilibrium.
+TEST(LawOfMotion, LocalDampingSettlesABallOnAPlane) {
+  Simulation sim;
+  sim.balls.add(granite(1, {0, 0, 5e-3}, 5e-3));
+  Wall floor;
+  floor.name = "floor";
+  sim.walls.add(floor);
+  sim.table.rules.push_back(linear_wall_rule(29e6, 0.4));
+  sim.settings.gravity = {0, 0, -9.81};
+  sim.settings.local_damping = 0.7;
+  ASSERT_GT(sim.solve(1e-8, 100000), 0);
+  EXPECT_NEAR(-sim.walls.walls[0].force.z, sim.balls.mass[0] * 9.81, 1e-7);
+}
+
+// Spec §4 and Eqs. 19-21: the automatic Δt of the two-grain hill contact at δ = 0.1 mm.
+TEST(TimeStep, AutomaticEstimateMatchesTheFormula) {
+  Simulation sim;
+  sim.balls.add(granite(1, {0, 0, 0}, 7.5e-3));
+  sim.balls.add(granite(2, {0, 0, 12.4e-3}, 5e-3));
+  sim.table.rules.push_back(hill_rule(0.4, 0.07));
+  sim.update_forces();
+  const HillMapping& m = sim.contacts.hill_map[0];
+  const double f = std::sqrt(1.0 + 0.035 * 0.035) - 0.035;
+  const double kn = 1.5 * m.kn * std::sqrt(1e-4) / (f * f), ks = m.ks * std::sqrt(1e-4) / (f * f);
+  const double arm2 = std::pow(5e-3 - 0.5e-4, 2);  // top ball: contact point 4.95 mm from its centre
+  double crit = 1e9;
+  for (int i = 0; i < 2; ++i) {
+    const double arm = i == 0 ? std::pow(7.5e-3 - 0.5e-4, 2) : arm2;
+    crit = std::min({crit, std::sqrt(sim.balls.mass[i] / (kn + ks)), std::sqrt(sim.balls.inertia[i] / (ks * arm))});
+  }
+  EXPECT_NEAR(sim.estimate_timestep(), 0.8 * crit, 1e-9 * crit);
+}
+
+// Appendix A (spec §2.10) through the engine: after shearing, doubling the overlap with no further
+// shear motion leaves the shear force unchanged (incremental update).
+TEST(AppendixA, DoublingOverlapKeepsShearForce) {
+  Scenario sc = load_scenario(R"(
+[simulation]
+timestep = 1e-6
+[[material]]
+name = "granite"
+density = 2650
+young_mod = 29e9
+pois_ratio = 0.15
+[[ball]]
+id = 1
+position = [0, 0, 0]
+radius = 7.5e-3
+material = "granite"
+fix = ["all"]
+[[ball]]
+id = 2
+position = [0, 0, 12.5e-3]
+radius = 5e-3
+material = "granite"
+fix = ["all"]
+[[contact_model]]
+between = "ball-ball"
+model = "hill"
+fric_coef = 1000.0
+[[stage]]
+type = "translate"
+ball = 2
+by = [0, 0, -1e-4]
+steps = 50
+[[stage]]
+type = "rotate"
+ball = 2
+by = [0, 0.02, 0]
+steps = 50
+[[stage]]
+type = "probe"
+label = "A"
+quantity = "contact.shear_force"
+balls = [1, 2]
+[[stage]]
+type = "translate"
+ball = 2
+by = [0, 0, -1e-4]
+steps = 50
+[[stage]]
+type = "probe"
+label = "B"
+quantity = "contact.shear_force"
+balls = [1, 2]
+[[stage]]
+type = "probe"
+label = "overlap"
+quantity = "contact.overlap"
+balls = [1, 2]
+)", "appendix_a.toml");
+  RunOptions opt;
+  opt.quiet = true;
+  opt.write_files = false;
+  std::ostringstream log;
+  const RunResult r = run_scenario(sc, opt, log);
+  EXPECT_NEAR(r.find("A")->value, 1478.272, 1e-3);
+  EXPECT_NEAR(r.find("B")->value, 1478.272, 1e-3);  // the absolute update would give 2090.6 N
+  EXPECT_NEAR(r.find("overlap")->value, 2e-4, 1e-12);
+}
+
+// Same input, same result, bit for bit.
+TEST(Determinism, TwoRunsAreBitwiseIdentical) {
+  auto run = [] {
+    Simulation sim = random_box(200, 3);
+    sim.settings.gravity = {0, 0, -9.81};
+    sim.settings.local_damping = 0.7;
+    sim.make_wet(20e3, 1e-3);
+    sim.cycle(300);
+    return sim.balls.position;
+  };
+  const auto a = run(), b = run();
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_TRUE(a[i] == b[i]) << "ball " << i;
+}
+
+}  // namespace
+}  // namespace hilldem
