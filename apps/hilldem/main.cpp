@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iostream>
 
+#include "hilldem/bench/bed_bench.hpp"
 #include "hilldem/core/error.hpp"
 #include "hilldem/io/runner.hpp"
 #include "hilldem/io/scenario.hpp"
@@ -42,6 +43,20 @@ int verify_command(const std::string& csv_path, bool quiet) {
   return report.all_pass() ? 0 : 1;
 }
 
+int bench_command(hilldem::BedBenchOptions o) {
+  if (o.data.empty()) {
+    for (const std::string p : {std::string("bench/pack_base.data"), std::string(HILLDEM_SOURCE_DIR) + "/bench/pack_base.data"})
+      if (std::filesystem::exists(p)) {
+        o.data = p;
+        break;
+      }
+    if (o.data.empty())
+      throw hilldem::InputError("no bed: pass --data FILE (a LAMMPS data file from bench/lammps/in.pack)");
+  }
+  std::cout << hilldem::run_bed_bench(o).line() << std::endl;
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -65,6 +80,14 @@ int main(int argc, char** argv) {
   auto* verify = app.add_subcommand("verify", "Run the memo's test problems and compare with its reference values");
   verify->add_option("--csv", csv, "also write the comparison as CSV to this file");
   verify->add_flag("-q,--quiet", quiet, "only the table");
+
+  hilldem::BedBenchOptions bench_opt;
+  auto* bench = app.add_subcommand("bench", "Time the dense bed of bench/ (hill model, periodic x-y, floor, gravity, dt 1e-6 s); prints one line");
+  bench->add_option("--data", bench_opt.data, "LAMMPS data file of the bed (default bench/pack_base.data)");
+  bench->add_option("--replicate", bench_opt.replicate, "copies in x and y (3: 100,800 spheres)")->check(CLI::Range(1, 20));
+  bench->add_option("--steps", bench_opt.steps, "timed steps")->check(CLI::Range(1, 100000000));
+  bench->add_option("--warmup", bench_opt.warmup, "untimed steps first")->check(CLI::Range(0, 100000000));
+  bench->add_option("--threads", bench_opt.threads, "OpenMP threads (0: default)")->check(CLI::Range(0, 1024));
 
   auto* quantities = app.add_subcommand("quantities", "List the quantities histories and probes can record");
 
@@ -98,6 +121,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (*verify) return verify_command(csv, quiet);
+    if (*bench) return bench_command(bench_opt);
     if (*quantities) {
       std::cout << hilldem::quantity_catalogue() << "\n";
       return 0;

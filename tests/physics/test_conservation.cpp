@@ -35,7 +35,7 @@ TEST(NewtonThird, ContactForcesCancelEveryStep) {
   });
   sim.cycle(200);
   EXPECT_GT(checked, 100);
-  EXPECT_GT(sim.contacts.size(), 20u);
+  EXPECT_GT(sim.contact_count(), 20u);
 }
 
 // No walls, no gravity, no local damping: total linear momentum of free balls is conserved.
@@ -75,7 +75,7 @@ Collision collide(double v, double damp_con) {
   // Cycle until the balls have separated again.
   for (int k = 0; k < 2'000'000; ++k) {
     sim.cycle(1);
-    if (sim.balls.velocity[1].x > 0 && sim.contacts.size() == 0) break;
+    if (sim.balls.velocity[1].x > 0 && sim.contact_count() == 0) break;
   }
   sim.cycle(10);
   return {v, sim.balls.velocity[1].x, e0, energy()};

@@ -25,13 +25,22 @@ std::size_t BallStore::add(const BallInit& b) {
   applied_moment.emplace_back();
   const std::size_t i = size() - 1;
   update_mass(i);
+  index_of_[b.id] = static_cast<std::uint32_t>(i);
   return i;
 }
 
 long BallStore::find(std::int64_t user_id) const {
-  for (std::size_t i = 0; i < id.size(); ++i)
-    if (id[i] == user_id) return static_cast<long>(i);
-  return -1;
+  const auto it = index_of_.find(user_id);
+  return it == index_of_.end() ? -1 : static_cast<long>(it->second);
+}
+
+void BallStore::permute(const std::vector<std::uint32_t>& order) {
+  for_each_column([&](auto& column) {
+    auto old = column;
+    for (std::size_t k = 0; k < order.size(); ++k) column[k] = old[order[k]];
+  });
+  index_of_.clear();
+  for (std::size_t i = 0; i < id.size(); ++i) index_of_[id[i]] = static_cast<std::uint32_t>(i);
 }
 
 void BallStore::update_mass(std::size_t i) {

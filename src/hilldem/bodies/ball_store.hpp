@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "hilldem/core/vec3.hpp"
@@ -61,6 +62,19 @@ class BallStore {
 
   // Recompute mass and inertia of ball i after its radius or density changed.
   void update_mass(std::size_t i);
+  // Reorder every column: new index k holds the ball that was at order[k].
+  void permute(const std::vector<std::uint32_t>& order);
+
+  // Apply f(column) to every per-ball column (one list, so nothing is forgotten when copying,
+  // permuting or checkpointing).
+  template <class F>
+  void for_each_column(F&& f) {
+    f(id); f(radius); f(density); f(mass); f(inertia); f(young_mod); f(pois_ratio); f(groups); f(fixity);
+    f(position); f(velocity); f(spin); f(contact_force); f(contact_moment); f(applied_force); f(applied_moment);
+  }
+
+ private:
+  std::unordered_map<std::int64_t, std::uint32_t> index_of_;  // user id -> index
 };
 
 // Interned group names: a ball or wall belongs to a set of groups, stored as a 64-bit mask.

@@ -41,7 +41,9 @@ std::optional<WallTouch> wall_touch(const Wall& w, const Vec3& c, double R) {
       const Vec3 q = closest_point_on_triangle(c, w.vertex[0], w.vertex[1], w.vertex[2]);
       const Vec3 d = q - c;
       const double dist = norm(d);
-      if (dist > 0.0) return WallTouch{d / dist, dist - R};
+      // Rounding in the face region leaves |q − c| ~ 1e-18 m for a centre in the facet's plane:
+      // treat anything that small as "on the facet" and use the face normal.
+      if (dist > 1e-12 * R) return WallTouch{d / dist, dist - R};
       // Centre exactly on the facet: push along the face normal.
       const Vec3 n = unit_or_zero(cross(w.vertex[1] - w.vertex[0], w.vertex[2] - w.vertex[0]));
       return WallTouch{-n, -R};

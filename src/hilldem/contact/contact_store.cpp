@@ -4,9 +4,11 @@
 
 namespace hilldem {
 
-void ContactStore::append_new(const ContactKey& k, int rule_index, ModelKind m, const LinearParams& lp,
-                              const HillParams& hp, const Vec3& n) {
+void ContactStore::append_new(const ContactKey& k, ImageCode img, int rule_index, ModelKind m,
+                              const LinearParams& lp, const HillParams& hp, const Vec3& n) {
   key.push_back(k);
+  image.push_back(img);
+  exists.push_back(0);
   rule.push_back(static_cast<std::int16_t>(rule_index));
   model.push_back(m);
   linear_params.push_back(lp);
@@ -25,6 +27,14 @@ void ContactStore::append_new(const ContactKey& k, int rule_index, ModelKind m, 
   shear_force.emplace_back();
   trial_shear.push_back(0.0);
   active.push_back(0);
+  k_tran.push_back(0.0);
+  k_shear.push_back(0.0);
+}
+
+std::size_t ContactStore::count_existing() const {
+  std::size_t n = 0;
+  for (std::uint8_t e : exists) n += e;
+  return n;
 }
 
 long ContactStore::find(const ContactKey& k) const {

@@ -1,11 +1,14 @@
-// ContactStore: every contact as structure-of-arrays, sorted by its key (ball a, kind, piece b), so
-// that history survives re-detection by a linear merge and every sum over contacts has a fixed order
-// (determinism regardless of thread count).
+// ContactStore: the neighbour list and the contacts on it, as structure-of-arrays sorted by key
+// (ball a, kind, piece b). Every pair within reach (proximity + skin) at the last rebuild has a row;
+// `exists` says whether the row is a contact in PFC's sense (created by proximity, deleted when
+// inactive beyond it). History survives rebuilds by a linear merge of sorted keys, and every sum over
+// rows has a fixed order (determinism regardless of thread count).
 #pragma once
 
 #include <cstdint>
 #include <vector>
 
+#include "hilldem/contact/cell_grid.hpp"
 #include "hilldem/contact/contact_kinematics.hpp"
 #include "hilldem/models/hill.hpp"
 #include "hilldem/models/linear.hpp"
@@ -26,6 +29,8 @@ class ContactStore {
 
   // Identity and model
   std::vector<ContactKey> key;
+  std::vector<ImageCode> image;        // periodic image of piece 2 (ball-ball)
+  std::vector<std::uint8_t> exists;    // a contact now (else only a neighbour pair)
   std::vector<std::int16_t> rule;      // index into ModelTable::rules
   std::vector<ModelKind> model;
   std::vector<LinearParams> linear_params;  // meaningful when model == Linear
@@ -48,12 +53,15 @@ class ContactStore {
   std::vector<Vec3> shear_force;       // F_s [N]
   std::vector<double> trial_shear;     // |F*_s| [N]
   std::vector<std::uint8_t> active;
+  std::vector<double> k_tran;          // k̂_n + k̂_s [N/m] for the time step (0 if inactive)
+  std::vector<double> k_shear;         // k̂_s [N/m]
 
   // Apply f(column_of_this, column_of_other) to every column: one list, so that copying, clearing and
   // reserving can never forget a column.
   template <class Self, class Other, class F>
   static void zip_columns(Self& self, Other& other, F&& f) {
-    f(self.key, other.key); f(self.rule, other.rule); f(self.model, other.model);
+    f(self.key, other.key); f(self.image, other.image); f(self.exists, other.exists);
+    f(self.rule, other.rule); f(self.model, other.model);
     f(self.linear_params, other.linear_params); f(self.hill_params, other.hill_params);
     f(self.linear_map, other.linear_map); f(self.hill_map, other.hill_map);
     f(self.shear_state, other.shear_state); f(self.shear_disp, other.shear_disp);
@@ -61,16 +69,32 @@ class ContactStore {
     f(self.gap, other.gap); f(self.point, other.point); f(self.force, other.force);
     f(self.normal_force, other.normal_force); f(self.moisture_force, other.moisture_force);
     f(self.shear_force, other.shear_force); f(self.trial_shear, other.trial_shear);
-    f(self.active, other.active);
+    f(self.active, other.active); f(self.k_tran, other.k_tran); f(self.k_shear, other.k_shear);
   }
 
   // Append row i of `from`, history included.
   void append_row(const ContactStore& from, std::size_t i) {
     zip_columns(*this, from, [i](auto& dst, const auto& src) { dst.push_back(src[i]); });
   }
-  // Append a fresh contact with default history (dry, no shear force).
-  void append_new(const ContactKey& k, int rule_index, ModelKind m, const LinearParams& lp,
+  // Append a fresh neighbour pair (not a contact yet) with default history.
+  void append_new(const ContactKey& k, ImageCode img, int rule_index, ModelKind m, const LinearParams& lp,
                   const HillParams& hp, const Vec3& n);
+  // Make row i a fresh contact: dry, no shear force or displacement, normal n.
+  void create(std::size_t i, const Vec3& n) {
+    exists[i] = 1;
+    shear_state[i] = shear_disp[i] = Vec3{};
+    moisture[i] = Moisture::Dry;  // new contacts start dry (spec §2.5)
+    normal[i] = n;
+  }
+  // Row i stops being a contact (its history is gone).
+  void remove(std::size_t i) {
+    exists[i] = 0;
+    active[i] = 0;
+    shear_state[i] = shear_disp[i] = force[i] = shear_force[i] = Vec3{};
+    normal_force[i] = moisture_force[i] = trial_shear[i] = k_tran[i] = k_shear[i] = 0.0;
+    moisture[i] = Moisture::Dry;
+  }
+  std::size_t count_existing() const;
   void clear() {
     zip_columns(*this, *this, [](auto& dst, auto&) { dst.clear(); });
   }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <sstream>
 
 #include "hilldem/contact/cell_grid.hpp"
@@ -24,7 +25,7 @@ std::int64_t Simulation::solve(double ratio, std::int64_t max_steps) {
 }
 
 void Simulation::update_forces() {
-  detect(settings.proximity);
+  rebuild_if_needed();
   force_pass(0.0);
   forces_ready_ = true;
 }
@@ -36,13 +37,30 @@ double Simulation::next_timestep() const {
   return last_dt > 0.0 ? last_dt : settings.timestep_max;
 }
 
+double Simulation::skin() const {
+  if (settings.skin > 0.0) return settings.skin;
+  if (balls.size() == 0) return 0.0;
+  const double sum = std::accumulate(balls.radius.begin(), balls.radius.end(), 0.0);
+  return 0.1 * 2.0 * sum / static_cast<double>(balls.size());
+}
+
 void Simulation::step_once() {
   if (!forces_ready_) update_forces();
   const double dt = next_timestep();
   advance_balls(balls, MotionSettings{settings.gravity, settings.local_damping}, dt);  // spec §1.2 steps 1-2
-  for (Wall& w : walls.walls) advance_wall(w, dt);
-  detect(settings.proximity);                                                           // step 3
-  force_pass(dt);                                                                       // step 4
+  for (Wall& w : walls.walls) {
+    // Bound on how far any point of the wall moved (for the neighbour-list check).
+    double reach = 0.0;
+    if (w.shape == WallShape::Facet)
+      for (const Vec3& v : w.vertex) reach = std::max(reach, norm(v - w.rotation_center));
+    else if (w.shape == WallShape::Plane && norm2(w.spin) > 0.0)
+      reach = std::numeric_limits<double>::infinity();
+    if (norm2(w.spin) > 0.0) wall_travel_ += norm(w.spin) * dt * reach;
+    wall_travel_ += (norm(w.velocity) + std::abs(w.radial_velocity)) * dt;
+    advance_wall(w, dt);
+  }
+  rebuild_if_needed();  // step 3
+  force_pass(dt);       // steps 3-4
   time += dt;
   ++steps;
   last_dt = dt;
@@ -55,7 +73,9 @@ ContactGeometry Simulation::geometry(std::size_t c) const {
   const double r1 = balls.radius[k.a];
   ContactGeometry g;
   if (k.kind == ContactKind::BallBall) {
-    const Vec3 d = balls.position[k.b] - x1;
+    Vec3 x2 = balls.position[k.b];
+    if (contacts.image[c] != kNoImage) x2 += image_shift(contacts.image[c], settings.box);
+    const Vec3 d = x2 - x1;
     const double dist = norm(d);
     g.normal = dist > 0.0 ? d / dist : contacts.normal[c];  // coincident centres: keep the old normal
     g.gap = dist - r1 - balls.radius[k.b];
@@ -87,9 +107,9 @@ void Simulation::compute_mapping(ContactStore& store, std::size_t c) const {
   } else {
     const std::size_t a = k.a, b = k.b;  // hill contacts are ball-ball only (checked by the table)
     store.hill_map[c] = hill_mapping(store.hill_params[c],
-                                        HillBodies{balls.radius[a], balls.radius[b], balls.young_mod[a],
-                                                   balls.young_mod[b], balls.pois_ratio[a], balls.pois_ratio[b],
-                                                   balls.mass[a], balls.mass[b]});
+                                     HillBodies{balls.radius[a], balls.radius[b], balls.young_mod[a],
+                                                balls.young_mod[b], balls.pois_ratio[a], balls.pois_ratio[b],
+                                                balls.mass[a], balls.mass[b]});
   }
 }
 
@@ -97,30 +117,70 @@ void Simulation::refresh_mappings() {
   for (std::size_t c = 0; c < contacts.size(); ++c) compute_mapping(contacts, c);
 }
 
-void Simulation::detect(double proximity) {
-  // Candidate keys, sorted: ball-ball pairs from the cell grid, ball-wall pairs by direct test.
-  std::vector<ContactKey> candidates;
-  for (const auto& [i, j] : find_ball_pairs(balls.position, balls.radius, proximity))
-    candidates.push_back({i, ContactKind::BallBall, j});
+void Simulation::wrap_positions() {
+  const PeriodicBox& box = settings.box;
+  if (!box.any()) return;
+  const Vec3 l = box.length();
+  for (Vec3& x : balls.position)
+    for (int d = 0; d < 3; ++d)
+      if (box.periodic[d]) {
+        x[d] = box.lo[d] + std::fmod(x[d] - box.lo[d], l[d]);
+        if (x[d] < box.lo[d]) x[d] += l[d];
+        if (x[d] >= box.hi[d]) x[d] -= l[d];
+      }
+}
+
+void Simulation::rebuild_if_needed() {
+  if (!rebuild_needed_ && position_at_build_.size() == balls.size()) {
+    const double half = 0.5 * skin();
+    double worst = 0.0;
+    for (std::size_t i = 0; i < balls.size(); ++i) worst = std::max(worst, norm2(balls.position[i] - position_at_build_[i]));
+    const double ball_travel = std::sqrt(worst);
+    // A pair outside the list was farther than `skin` beyond proximity at the rebuild.
+    if (ball_travel <= half && ball_travel + wall_travel_ <= 2.0 * half) return;
+  }
+  rebuild(settings.proximity);
+}
+
+void Simulation::rebuild(double proximity) {
+  wrap_positions();
+  const double reach = proximity + skin();
+  std::vector<PairCandidate> candidates = find_pair_candidates(balls.position, balls.radius, reach, settings.box);
+  std::vector<ContactKey> keys;
+  keys.reserve(candidates.size());
+  for (const PairCandidate& p : candidates) keys.push_back({p.i, ContactKind::BallBall, p.j});
+  std::vector<std::pair<ContactKey, ImageCode>> wall_keys;
   for (std::uint32_t w = 0; w < walls.size(); ++w)
     for (std::uint32_t i = 0; i < balls.size(); ++i) {
       const auto touch = wall_touch(walls.walls[w], balls.position[i], balls.radius[i]);
-      if (touch && touch->gap <= proximity) candidates.push_back({i, ContactKind::BallWall, w});
+      if (touch && touch->gap <= reach) wall_keys.push_back({{i, ContactKind::BallWall, w}, kNoImage});
     }
-  std::sort(candidates.begin(), candidates.end());
+  // Merge the two candidate lists into one sorted list (ball-ball keys are already sorted).
+  std::vector<std::pair<ContactKey, ImageCode>> all;
+  all.reserve(keys.size() + wall_keys.size());
+  for (std::size_t k = 0; k < keys.size(); ++k) all.push_back({keys[k], candidates[k].image});
+  all.insert(all.end(), wall_keys.begin(), wall_keys.end());
+  std::sort(all.begin(), all.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
 
-  // Merge with the existing contacts (also sorted): history survives re-detection. A contact that is
-  // no longer a candidate is kept only while it must be (a wet hill contact, spec §2.5).
+  // Merge with the existing rows (also sorted): history survives. An old row that is no longer a
+  // candidate is kept only while it must be: a wet hill contact (spec §2.5).
   ContactStore next;
+  next.key.reserve(all.size());
   unassigned_pairs_ = 0;
   std::size_t o = 0;
   auto keep_old_if_needed = [&](std::size_t i) {
-    if (contacts.model[i] == ModelKind::Hill && contacts.moisture[i] == Moisture::Wet) next.append_row(contacts, i);
+    if (contacts.exists[i] && contacts.model[i] == ModelKind::Hill && contacts.moisture[i] == Moisture::Wet) {
+      next.append_row(contacts, i);
+      const ContactKey& k = contacts.key[i];
+      if (k.kind == ContactKind::BallBall)
+        next.image.back() = nearest_image(balls.position[k.a], balls.position[k.b], settings.box);
+    }
   };
-  for (const ContactKey& key : candidates) {
+  for (const auto& [key, image] : all) {
     while (o < contacts.size() && contacts.key[o] < key) keep_old_if_needed(o++);
     if (o < contacts.size() && contacts.key[o] == key) {
       next.append_row(contacts, o++);
+      next.image.back() = image;
       continue;
     }
     const int r = table.match(key.kind, balls.groups[key.a], piece2_groups(key));
@@ -129,24 +189,50 @@ void Simulation::detect(double proximity) {
       continue;
     }
     const ModelRule& rule = table.rules[r];
-    const Vec3 n0 = key.kind == ContactKind::BallBall
-                        ? unit_or_zero(balls.position[key.b] - balls.position[key.a])
-                        : wall_touch(walls.walls[key.b], balls.position[key.a], balls.radius[key.a])->normal;
-    next.append_new(key, r, rule.model, rule.linear, rule.hill, n0);
+    next.append_new(key, image, r, rule.model, rule.linear, rule.hill, Vec3{0, 0, 1});
     compute_mapping(next, next.size() - 1);
   }
   while (o < contacts.size()) keep_old_if_needed(o++);
   contacts = std::move(next);
+
+  // Per-ball row lists (CSR), in row order: the fixed summation order of collect_forces().
+  const std::size_t n = balls.size();
+  ball_rows_start_.assign(n + 1, 0);
+  wall_rows_.clear();
+  for (std::size_t c = 0; c < contacts.size(); ++c) {
+    const ContactKey& k = contacts.key[c];
+    ++ball_rows_start_[k.a + 1];
+    if (k.kind == ContactKind::BallBall) ++ball_rows_start_[k.b + 1];
+    else wall_rows_.push_back(static_cast<std::uint32_t>(c));
+  }
+  for (std::size_t i = 0; i < n; ++i) ball_rows_start_[i + 1] += ball_rows_start_[i];
+  ball_rows_.assign(ball_rows_start_[n], 0);
+  std::vector<std::uint32_t> fill(ball_rows_start_.begin(), ball_rows_start_.end() - 1);
+  for (std::size_t c = 0; c < contacts.size(); ++c) {
+    const ContactKey& k = contacts.key[c];
+    const auto row = static_cast<std::int64_t>(c) + 1;
+    ball_rows_[fill[k.a]++] = -row;
+    if (k.kind == ContactKind::BallBall) ball_rows_[fill[k.b]++] = row;
+  }
+  position_at_build_ = balls.position;
+  wall_travel_ = 0.0;
+  rebuild_needed_ = false;
+  ++rebuilds_;
 }
 
 void Simulation::force_pass(double dt) {
-  std::fill(balls.contact_force.begin(), balls.contact_force.end(), Vec3{});
-  std::fill(balls.contact_moment.begin(), balls.contact_moment.end(), Vec3{});
-  for (Wall& w : walls.walls) w.force = w.moment = Vec3{};
-
-  for (std::size_t c = 0; c < contacts.size(); ++c) {
-    const ContactKey& key = contacts.key[c];
+  const std::size_t rows = contacts.size();
+  const double proximity = settings.proximity;
+  bool bad = false;
+  std::size_t bad_row = 0;
+#pragma omp parallel for schedule(static) if (rows > kParallelMin)
+  for (std::size_t c = 0; c < rows; ++c) {
     const ContactGeometry g = geometry(c);
+    if (!contacts.exists[c]) {
+      if (!g.valid || g.gap > proximity) continue;  // a neighbour pair, not a contact
+      contacts.create(c, g.normal);                   // created by proximity
+    }
+    const ContactKey& key = contacts.key[c];
     const std::size_t a = key.a;
     const bool ball2 = key.kind == ContactKind::BallBall;
 
@@ -154,7 +240,8 @@ void Simulation::force_pass(double dt) {
     const Vec3 v1 = balls.velocity[a] + cross(balls.spin[a], g.point - balls.position[a]);
     Vec3 v2, spin2;
     if (ball2) {
-      v2 = balls.velocity[key.b] + cross(balls.spin[key.b], g.point - balls.position[key.b]);
+      const Vec3 x2 = g.point + g.normal * (balls.radius[key.b] + 0.5 * g.gap);  // centre of (the image of) ball 2
+      v2 = balls.velocity[key.b] + cross(balls.spin[key.b], g.point - x2);
       spin2 = balls.spin[key.b];
     } else {
       v2 = wall_point_velocity(walls.walls[key.b], g.point);
@@ -167,11 +254,13 @@ void Simulation::force_pass(double dt) {
     Vec3 force, shear;
     double fn = 0.0, fm = 0.0, trial = 0.0;
     bool active = false;
+    StiffnessEstimate stiff;
     if (contacts.model[c] == ModelKind::Linear) {
       const LinearState prev{carry_into_plane(contacts.shear_state[c], n_old, g.normal, mean_spin_n, dt)};
       const LinearResult r = linear_force(contacts.linear_params[c], contacts.linear_map[c], kin, prev);
       contacts.shear_state[c] = r.state.shear_force;
       force = r.force, shear = r.shear_force, fn = r.normal_force, trial = r.trial_shear, active = r.active;
+      if (active) stiff = {contacts.linear_map[c].kn, contacts.linear_map[c].ks};
     } else {
       const HillState prev{carry_into_plane(contacts.shear_state[c], n_old, g.normal, mean_spin_n, dt),
                            contacts.moisture[c]};
@@ -180,6 +269,14 @@ void Simulation::force_pass(double dt) {
       contacts.moisture[c] = r.state.moisture;
       force = r.force, shear = r.shear_force, fn = r.surface_normal, fm = r.moisture_force;
       trial = r.trial_shear, active = r.active;
+      if (active) stiff = hill_timestep_stiffness(contacts.hill_params[c], contacts.hill_map[c], g.gap);
+    }
+    // Deleted when inactive beyond the proximity distance (a wet contact stays active: spec §2.5).
+    if (!active && g.gap > proximity) {
+      contacts.remove(c);
+      contacts.gap[c] = g.gap;
+      contacts.normal[c] = g.normal;
+      continue;
     }
     // Accumulated shear displacement (reported, not used by the laws): carried like the force.
     contacts.shear_disp[c] = active ? carry_into_plane(contacts.shear_disp[c], n_old, g.normal, mean_spin_n, dt) +
@@ -188,65 +285,81 @@ void Simulation::force_pass(double dt) {
     contacts.normal[c] = g.normal;
     contacts.gap[c] = g.gap;
     contacts.point[c] = g.point;
-    contacts.force[c] = force;
+    contacts.force[c] = active ? force : Vec3{};
     contacts.normal_force[c] = fn;
     contacts.moisture_force[c] = fm;
     contacts.shear_force[c] = shear;
     contacts.trial_shear[c] = trial;
     contacts.active[c] = active;
-    if (!active) continue;
-
-    // Force on piece 2 is F_c, on piece 1 it is −F_c (spec conventions); moments about each centre.
-    balls.contact_force[a] -= force;
-    balls.contact_moment[a] -= cross(g.point - balls.position[a], force);
-    if (ball2) {
-      balls.contact_force[key.b] += force;
-      balls.contact_moment[key.b] += cross(g.point - balls.position[key.b], force);
-    } else {
-      Wall& w = walls.walls[key.b];
-      w.force += force;
-      w.moment += cross(g.point - w.rotation_center, force);
-    }
+    contacts.k_tran[c] = stiff.kn + stiff.ks;
+    contacts.k_shear[c] = stiff.ks;
     if (!std::isfinite(force.x + force.y + force.z)) {
-      std::ostringstream msg;
-      msg << "non-finite contact force at step " << steps + 1 << " between ball " << balls.id[a] << " and "
-          << (ball2 ? "ball " + std::to_string(balls.id[key.b]) : "wall '" + walls.walls[key.b].name + "'")
-          << " (gap " << g.gap << " m): the run is unstable; reduce the time step";
-      throw RunError(msg.str());
+#pragma omp critical(hilldem_bad_force)
+      if (!bad || c < bad_row) bad = true, bad_row = c;
     }
+  }
+  if (bad) {
+    const ContactKey& key = contacts.key[bad_row];
+    std::ostringstream msg;
+    msg << "non-finite contact force at step " << steps + 1 << " between ball " << balls.id[key.a] << " and "
+        << (key.kind == ContactKind::BallBall ? "ball " + std::to_string(balls.id[key.b])
+                                              : "wall '" + walls.walls[key.b].name + "'")
+        << " (gap " << contacts.gap[bad_row] << " m): the run is unstable; reduce the time step";
+    throw RunError(msg.str());
+  }
+  collect_forces();
+}
+
+void Simulation::collect_forces() {
+  // Force on piece 2 is F_c, on piece 1 it is −F_c (spec conventions); moments about each centre.
+  // Each ball sums its own rows in row order: the same result for any number of threads.
+  const std::size_t n = balls.size();
+#pragma omp parallel for schedule(static) if (n > kParallelMin)
+  for (std::size_t i = 0; i < n; ++i) {
+    Vec3 f, m;
+    const Vec3 x = balls.position[i];
+    for (std::uint32_t k = ball_rows_start_[i]; k < ball_rows_start_[i + 1]; ++k) {
+      const std::int64_t code = ball_rows_[k];
+      const std::size_t c = static_cast<std::size_t>(std::abs(code) - 1);
+      if (!contacts.active[c]) continue;
+      const Vec3 fc = code > 0 ? contacts.force[c] : -contacts.force[c];
+      // Lever arm from the ball centre to x_c; for a periodic image use the arm along the normal.
+      const Vec3 arm = code > 0 ? contacts.point[c] - (contacts.point[c] + contacts.normal[c] *
+                                                                              (balls.radius[i] + 0.5 * contacts.gap[c]))
+                                : contacts.point[c] - x;
+      f += fc;
+      m += cross(arm, fc);
+    }
+    balls.contact_force[i] = f;
+    balls.contact_moment[i] = m;
+  }
+  for (Wall& w : walls.walls) w.force = w.moment = Vec3{};
+  for (std::uint32_t c : wall_rows_) {
+    if (!contacts.active[c]) continue;
+    Wall& w = walls.walls[contacts.key[c].b];
+    w.force += contacts.force[c];
+    w.moment += cross(contacts.point[c] - w.rotation_center, contacts.force[c]);
   }
 }
 
 double Simulation::estimate_timestep() const {
   // Per-body sums of the contact-returned stiffnesses (spec §4): k_tran = Σ(k̂_n + k̂_s),
-  // k_rot = Σ k̂_s |x_c − x|². Δt_crit = min(√(m/k_tran), √(I/k_rot)).
-  std::vector<double> k_tran(balls.size(), 0.0), k_rot(balls.size(), 0.0);
-  bool any = false;
-  for (std::size_t c = 0; c < contacts.size(); ++c) {
-    const ContactGeometry g = geometry(c);
-    if (!g.valid) continue;
-    StiffnessEstimate s;
-    if (contacts.model[c] == ModelKind::Linear) {
-      if (g.gap > 0.0) continue;  // inactive
-      s = {contacts.linear_map[c].kn, contacts.linear_map[c].ks};
-    } else {
-      if (!hill_active(contacts.moisture[c], g.gap)) continue;
-      s = hill_timestep_stiffness(contacts.hill_params[c], contacts.hill_map[c], g.gap);
-    }
-    any = true;
-    const ContactKey& k = contacts.key[c];
-    auto add = [&](std::size_t i) {
-      k_tran[i] += s.kn + s.ks;
-      k_rot[i] += s.ks * norm2(g.point - balls.position[i]);
-    };
-    add(k.a);
-    if (k.kind == ContactKind::BallBall) add(k.b);
-  }
-  if (!any) return 0.0;
+  // k_rot = Σ k̂_s |x_c − x|². Δt_crit = min(√(m/k_tran), √(I/k_rot)). The stiffnesses were stored
+  // by the last force pass (hill Eqs. 19-21; linear k_n, k_s).
+  const std::size_t n = balls.size();
   double crit = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < balls.size(); ++i) {
-    if (k_tran[i] > 0.0) crit = std::min(crit, std::sqrt(balls.mass[i] / k_tran[i]));
-    if (k_rot[i] > 0.0) crit = std::min(crit, std::sqrt(balls.inertia[i] / k_rot[i]));
+#pragma omp parallel for schedule(static) reduction(min : crit) if (n > kParallelMin)
+  for (std::size_t i = 0; i < n; ++i) {
+    double k_tran = 0.0, k_rot = 0.0;
+    for (std::uint32_t k = ball_rows_start_[i]; k < ball_rows_start_[i + 1]; ++k) {
+      const std::size_t c = static_cast<std::size_t>(std::abs(ball_rows_[k]) - 1);
+      if (!contacts.active[c]) continue;
+      const double arm = balls.radius[i] + 0.5 * contacts.gap[c];  // |x_c − x| (the contact point is on the normal)
+      k_tran += contacts.k_tran[c];
+      k_rot += contacts.k_shear[c] * arm * arm;
+    }
+    if (k_tran > 0.0) crit = std::min(crit, std::sqrt(balls.mass[i] / k_tran));
+    if (k_rot > 0.0) crit = std::min(crit, std::sqrt(balls.inertia[i] / k_rot));
   }
   return std::isfinite(crit) ? settings.timestep_safety * crit : 0.0;
 }
@@ -280,15 +393,18 @@ double Simulation::mean_unbalanced_ratio() const {
 }
 
 std::size_t Simulation::make_wet(double suction, double gap) {
-  detect(std::max(gap, settings.proximity));  // step 1: contacts for every pair within the gap
+  rebuild(std::max(gap, settings.proximity));  // step 1: every pair within the gap has a row
+  rebuild_needed_ = true;                       // back to the normal reach at the next cycle
   std::size_t wet = 0;
   for (std::size_t c = 0; c < contacts.size(); ++c) {
     if (contacts.model[c] != ModelKind::Hill) continue;
-    if (geometry(c).gap <= gap) {  // steps 2-3: suction, then make_wet(g_m)
+    const ContactGeometry g = geometry(c);
+    if (g.gap <= gap) {  // steps 2-3: a contact (new ones start here), suction, then make_wet(g_m)
+      if (!contacts.exists[c]) contacts.create(c, g.normal);
       contacts.hill_params[c].suction = suction;
       contacts.moisture[c] = Moisture::Wet;
     }
-    if (contacts.moisture[c] == Moisture::Wet) ++wet;
+    if (contacts.exists[c] && contacts.moisture[c] == Moisture::Wet) ++wet;
   }
   return wet;
 }
@@ -296,7 +412,7 @@ std::size_t Simulation::make_wet(double suction, double gap) {
 std::size_t Simulation::make_dry() {
   std::size_t was_wet = 0;
   for (std::size_t c = 0; c < contacts.size(); ++c) {
-    if (contacts.model[c] != ModelKind::Hill) continue;
+    if (contacts.model[c] != ModelKind::Hill || !contacts.exists[c]) continue;
     if (contacts.moisture[c] == Moisture::Wet) ++was_wet;
     contacts.moisture[c] = Moisture::Dry;
   }
@@ -307,13 +423,41 @@ long Simulation::find_ball_ball(std::int64_t id1, std::int64_t id2) const {
   long a = balls.find(id1), b = balls.find(id2);
   if (a < 0 || b < 0) return -1;
   if (a > b) std::swap(a, b);
-  return contacts.find({static_cast<std::uint32_t>(a), ContactKind::BallBall, static_cast<std::uint32_t>(b)});
+  const long c = contacts.find({static_cast<std::uint32_t>(a), ContactKind::BallBall, static_cast<std::uint32_t>(b)});
+  return c >= 0 && contacts.exists[c] ? c : -1;
 }
 
 long Simulation::find_ball_wall(std::int64_t ball_id, std::size_t wall) const {
   const long a = balls.find(ball_id);
   if (a < 0) return -1;
-  return contacts.find({static_cast<std::uint32_t>(a), ContactKind::BallWall, static_cast<std::uint32_t>(wall)});
+  const long c = contacts.find({static_cast<std::uint32_t>(a), ContactKind::BallWall, static_cast<std::uint32_t>(wall)});
+  return c >= 0 && contacts.exists[c] ? c : -1;
+}
+
+void Simulation::sort_balls_spatially() {
+  if (contact_count() > 0) throw RunError("sort_balls_spatially: only before any contact exists");
+  const std::size_t n = balls.size();
+  if (n < 2) return;
+  // Order by cell of a grid one mean diameter wide (z, then y, then x).
+  Vec3 lo = balls.position[0], hi = lo;
+  for (const Vec3& x : balls.position)
+    for (int d = 0; d < 3; ++d) lo[d] = std::min(lo[d], x[d]), hi[d] = std::max(hi[d], x[d]);
+  const double cell = std::max(2.0 * std::accumulate(balls.radius.begin(), balls.radius.end(), 0.0) / n, 1e-12);
+  auto cell_index = [&](const Vec3& x) {
+    const auto c = [&](int d) { return static_cast<std::uint64_t>((x[d] - lo[d]) / cell); };
+    const std::uint64_t nx = c(0) + 1;
+    const std::uint64_t ny = static_cast<std::uint64_t>((hi.y - lo.y) / cell) + 1;
+    const std::uint64_t mx = static_cast<std::uint64_t>((hi.x - lo.x) / cell) + 1;
+    return (c(2) * ny + c(1)) * mx + (nx - 1);
+  };
+  std::vector<std::uint32_t> order(n);
+  std::iota(order.begin(), order.end(), 0u);
+  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t p, std::uint32_t q) {
+    return cell_index(balls.position[p]) < cell_index(balls.position[q]);
+  });
+  balls.permute(order);
+  contacts.clear();
+  invalidate_forces();
 }
 
 }  // namespace hilldem

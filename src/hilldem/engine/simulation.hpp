@@ -1,8 +1,11 @@
 // Simulation: owns the stores, the assignment table and the clock, and runs the cycle of spec §1.2:
 //   1. velocities to t+Δt/2 from the forces at t (local damping, gravity, fixity),
 //   2. positions to t+Δt, walls moved by their imposed motion,
-//   3. contact detection and resolution at the new positions (history kept by a sorted merge),
-//   4. force-displacement law of every contact -> forces at t+Δt, summed per body in a fixed order.
+//   3. contact detection and resolution at the new positions: the neighbour list (pairs within
+//      proximity + skin) is rebuilt only when something moved more than half the skin, history
+//      kept by a sorted merge; contacts are created and deleted on it by proximity,
+//   4. force-displacement law of every contact -> forces at t+Δt, summed per body in a fixed order
+//      (per-ball row lists), so results are bitwise identical for any number of threads.
 // Lab-test drivers and the scenario runner use only this public API.
 #pragma once
 
@@ -27,6 +30,8 @@ struct SimulationSettings {
   double timestep_safety = 0.8;  // f [-], Δt = f Δt_crit
   double timestep_max = 1e-4;    // [s] Δt used when no contact reports a stiffness yet
   double proximity = 0.0;        // [m] contacts are created for gaps ≤ proximity
+  double skin = 0.0;             // [m] neighbour-list skin; 0 = 0.1 × mean ball diameter
+  PeriodicBox box;               // periodic directions and their period [lo, hi) [m]
 };
 
 // Geometry of a contact at the current positions.
@@ -76,9 +81,20 @@ class Simulation {
 
   // Recompute every contact's mapping (after properties of bodies or contacts changed).
   void refresh_mappings();
+  // Rebuild the neighbour list before the next force evaluation (after bodies were added or moved
+  // by hand, or the table changed).
+  void invalidate_neighbours() { rebuild_needed_ = true; }
+  // Number of contacts (rows that exist), and of neighbour-list rebuilds so far.
+  std::size_t contact_count() const { return contacts.count_existing(); }
+  std::int64_t rebuilds() const { return rebuilds_; }
+  // Reorder balls along the cell grid for memory locality. Only before any contact exists.
+  void sort_balls_spatially();
   // Forces are recomputed (without any shear increment) before the next cycle: call after moving
   // bodies by hand.
-  void invalidate_forces() { forces_ready_ = false; }
+  void invalidate_forces() {
+    forces_ready_ = false;
+    rebuild_needed_ = true;
+  }
   // Detect contacts and compute forces at the current state with no motion (Δt = 0 increments).
   void update_forces();
 
@@ -91,13 +107,24 @@ class Simulation {
 
  private:
   void step_once();
-  void detect(double proximity);
+  void rebuild(double reach);
+  void rebuild_if_needed();
   void force_pass(double dt);
+  void collect_forces();
   void compute_mapping(ContactStore& store, std::size_t c) const;
   std::uint64_t piece2_groups(const ContactKey& k) const;
+  double skin() const;
+  void wrap_positions();
 
   bool forces_ready_ = false;
+  bool rebuild_needed_ = true;
   std::size_t unassigned_pairs_ = 0;
+  std::int64_t rebuilds_ = 0;
+  std::vector<Vec3> position_at_build_;
+  double wall_travel_ = 0.0;                 // bound on any wall point's motion since the rebuild [m]
+  std::vector<std::uint32_t> ball_rows_start_;  // CSR: rows of ball i are ball_rows_[start[i]..start[i+1])
+  std::vector<std::int64_t> ball_rows_;      // row r as +(r+1) when the ball is piece 2, −(r+1) piece 1
+  std::vector<std::uint32_t> wall_rows_;     // rows of ball-wall pairs
 };
 
 }  // namespace hilldem

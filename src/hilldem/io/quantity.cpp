@@ -112,7 +112,7 @@ double sim_value(const Simulation& s, const std::string& f) {
   if (f == "time") return s.time;
   if (f == "step") return static_cast<double>(s.steps);
   if (f == "timestep") return s.last_dt;
-  if (f == "contacts") return static_cast<double>(s.contacts.size());
+  if (f == "contacts") return static_cast<double>(s.contact_count());
   if (f == "unbalanced_ratio") return s.mean_unbalanced_ratio();
   if (f == "kinetic_energy") {
     double e = 0.0;
@@ -123,7 +123,7 @@ double sim_value(const Simulation& s, const std::string& f) {
   double n = 0.0;
   for (std::size_t c = 0; c < s.contacts.size(); ++c) {
     if (f == "active_contacts") n += s.contacts.active[c];
-    if (f == "wet_contacts") n += s.contacts.moisture[c] == Moisture::Wet;
+    if (f == "wet_contacts") n += s.contacts.exists[c] && s.contacts.moisture[c] == Moisture::Wet;
   }
   return n;
 }

@@ -21,6 +21,7 @@ std::string contact_listing(const Simulation& sim) {
                                 "normal[N]", "state", "assigned by");
   const ContactStore& c = sim.contacts;
   for (std::size_t k = 0; k < c.size(); ++k) {
+    if (!c.exists[k]) continue;
     const ContactKey& key = c.key[k];
     const std::string pieces =
         key.kind == ContactKind::BallBall
@@ -33,7 +34,7 @@ std::string contact_listing(const Simulation& sim) {
     out += fmt::format("{:<24} {:<7} {:>12.5g} {:>12.5g} {:<5} {}\n", pieces, to_string(c.model[k]), c.gap[k],
                        c.normal_force[k], state, sim.table.explain(c.rule[k]));
   }
-  out += fmt::format("{} contacts; {} candidate pairs matched no rule at the last detection\n", c.size(),
+  out += fmt::format("{} contacts; {} neighbour pairs matched no rule at the last detection\n", sim.contact_count(),
                      sim.unassigned_pairs());
   return out;
 }
@@ -200,7 +201,7 @@ RunResult run_scenario(Scenario& sc, const RunOptions& options, std::ostream& lo
     }
     if (!options.quiet)
       log << fmt::format("{} {}  (step {}, t = {:.6g} s, {} contacts)\n", head, what, sim.steps, sim.time,
-                         sim.contacts.size());
+                         sim.contact_count());
   }
   if (history) history->flush();
   sim.observers.clear();

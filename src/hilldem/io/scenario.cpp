@@ -7,6 +7,9 @@
 #include <sstream>
 
 #include "hilldem/core/error.hpp"
+#include "hilldem/io/packing_import.hpp"
+
+#include <filesystem>
 
 namespace hilldem {
 
@@ -79,6 +82,8 @@ class Reader {
     for (TableReader& t : root_.tables("material")) read_material(t);
     for (TableReader& t : root_.tables("ball")) read_ball(t, sc.sim);
     for (TableReader& t : root_.tables("ball_grid")) read_ball_grid(t, sc.sim);
+    for (TableReader& t : root_.tables("packing")) read_packing_table(t, sc.sim);
+    finish_box(sc.sim);
     for (TableReader& t : root_.tables("wall")) read_wall(t, sc.sim);
     for (TableReader& t : root_.tables("contact_model")) read_rule(t, sc.sim);
     for (TableReader& t : root_.tables("history")) read_history(t, sc);
@@ -104,6 +109,18 @@ class Reader {
     s.timestep_safety = t->real("timestep_safety", 0.8, Range::open_closed(0.0, 1.0), "[-]");
     s.timestep_max = t->real("timestep_max", 1e-4, Range::open(0.0, 1.0), "[s]");
     s.proximity = t->real("proximity", 0.0, Range::closed(0.0, kInf), "[m]");
+    s.skin = t->real("skin", 0.0, Range::closed(0.0, kInf), "[m] (0: 0.1 x mean diameter)");
+    for (const std::string& d : t->strings("periodic")) {
+      if (d != "x" && d != "y" && d != "z") t->fail("periodic", "directions must be \"x\", \"y\" or \"z\"; got \"" + d + "\"");
+      s.box.periodic[d[0] - 'x'] = true;
+    }
+    if (t->has("box_min") || t->has("box_max")) {
+      s.box.lo = t->vec3("box_min", std::nullopt, Range::any(), "[m]");
+      s.box.hi = t->vec3("box_max", std::nullopt, Range::any(), "[m]");
+      for (int d = 0; d < 3; ++d)
+        if (s.box.periodic[d] && !(s.box.lo[d] < s.box.hi[d])) t->fail("box_max", "must exceed box_min in every periodic direction");
+      box_given_ = true;
+    }
     t->finish();
   }
 
@@ -180,6 +197,54 @@ class Reader {
           b.position = origin + Vec3{i * spacing, j * spacing, k * spacing};
           add_ball(t, sim, b);
         }
+  }
+
+  // [[packing]]: balls from a file (path relative to the scenario file).
+  void read_packing_table(TableReader& t, Simulation& sim) {
+    const std::string file = t.string("file", std::nullopt);
+    const std::string format = t.choice("format", "lammps", {"lammps", "xyzr"});
+    const Material& m = material(t);
+    const std::uint64_t groups = read_groups(t, sim.groups);
+    const auto rep = t.integers("replicate");
+    if (!rep.empty() && (rep.size() != 3 || rep[0] < 1 || rep[1] < 1 || rep[2] < 1 || rep[0] * rep[1] * rep[2] > 10000))
+      t.fail("replicate", "must be [nx, ny, nz] with each >= 1 (at most 10000 copies)");
+    std::int64_t next_id = 1;
+    for (std::int64_t id : ids_) next_id = std::max(next_id, id + 1);
+    std::int64_t id = t.integer("first_id", next_id, 0, INT64_MAX);
+    t.finish();
+    const std::filesystem::path base = std::filesystem::path(file_).parent_path();
+    const std::string path = std::filesystem::path(file).is_absolute() ? file : (base / file).string();
+    Packing p = read_packing(path, format == "lammps" ? PackingFormat::Lammps : PackingFormat::Xyzr);
+    if (!rep.empty()) {
+      const int n[3] = {static_cast<int>(rep[0]), static_cast<int>(rep[1]), static_cast<int>(rep[2])};
+      if (!p.has_box) t.fail("replicate", "needs a packing with a box (format \"lammps\")");
+      replicate(p, n);
+    }
+    if (p.has_box && !box_given_) {
+      sim.settings.box.lo = p.box_lo;
+      sim.settings.box.hi = p.box_hi;
+      box_given_ = true;
+    }
+    for (const ImportedBall& ib : p.balls) {
+      BallInit b;
+      b.id = id++;
+      b.position = ib.position;
+      b.radius = ib.radius;
+      b.density = ib.density > 0.0 ? ib.density : m.density;
+      b.young_mod = m.young_mod;
+      b.pois_ratio = m.pois_ratio;
+      b.groups = groups;
+      add_ball(t, sim, b);
+    }
+  }
+
+  void finish_box(Simulation& sim) {
+    if (!sim.settings.box.any()) return;
+    if (!box_given_)
+      throw InputError(file_ + ": key 'simulation.periodic' needs simulation.box_min and box_max [m] (or a [[packing]] LAMMPS file with a box)");
+    for (std::size_t i = 0; i < sim.balls.size(); ++i)
+      if (!std::isfinite(norm(sim.balls.position[i])))
+        throw InputError(file_ + ": ball " + std::to_string(sim.balls.id[i]) + " has a non-finite position");
   }
 
   void motion_keys(TableReader& t, Wall& w) {
@@ -439,6 +504,7 @@ class Reader {
   std::map<std::string, Material> materials_;
   std::set<std::int64_t> ids_;
   std::set<std::string> wall_names_, labels_;
+  bool box_given_ = false;
 };
 
 }  // namespace

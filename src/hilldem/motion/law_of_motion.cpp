@@ -12,7 +12,9 @@ inline double damped(double f, double v, double alpha) {
 
 void advance_balls(BallStore& balls, const MotionSettings& s, double dt) {
   const double alpha = s.local_damping;
-  for (std::size_t i = 0; i < balls.size(); ++i) {
+  const std::size_t n = balls.size();
+#pragma omp parallel for schedule(static) if (n > kParallelMin)
+  for (std::size_t i = 0; i < n; ++i) {
     const FixityMask fix = balls.fixity[i];
     const Vec3 f = unbalanced_force(balls, i, s.gravity);
     const Vec3 mo = unbalanced_moment(balls, i);

@@ -6,6 +6,9 @@
 
 namespace hilldem {
 
+// Loops shorter than this run on one thread: waking threads costs more than it saves.
+inline constexpr std::size_t kParallelMin = 2048;
+
 struct MotionSettings {
   Vec3 gravity;                // g [m/s²]
   double local_damping = 0.0;  // α [-], [0, 1)

@@ -1,0 +1,37 @@
+// The speed benchmark of issue #4: the settled dense bed of shared/bench/lammps (granite spheres,
+// radii 4-6 mm, periodic in x and y, floor at z = 0, gravity, Δt = 1e-6 s) run with the hill model
+// (E 29 GPa, ν 0.15, μ 0.4, γ_h 0.07 ≈ restitution 0.906) and a linear floor (E* 29 GPa).
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "hilldem/engine/simulation.hpp"
+#include "hilldem/io/packing_import.hpp"
+
+namespace hilldem {
+
+struct BedBenchOptions {
+  std::string data;           // LAMMPS data file written by in.pack
+  int replicate = 1;          // copies in x and y (3 -> 100,800 spheres)
+  std::int64_t warmup = 200;  // untimed steps
+  std::int64_t steps = 1000;  // timed steps
+  int threads = 0;            // 0 = OpenMP default
+};
+
+struct BedBenchResult {
+  std::size_t particles = 0;
+  std::int64_t steps = 0;
+  double wall_seconds = 0.0;
+  double particle_steps_per_second = 0.0;
+  double contacts_per_particle = 0.0;  // Z: 2 × contacts / particles
+  int threads = 1;
+  std::int64_t rebuilds = 0;           // neighbour-list rebuilds during the timed steps
+  std::string line() const;            // one machine-readable line
+};
+
+// The bed as a Simulation, ready to cycle.
+Simulation make_bed(const Packing& packing);
+BedBenchResult run_bed_bench(const BedBenchOptions& options);
+
+}  // namespace hilldem
