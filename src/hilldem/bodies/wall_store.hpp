@@ -39,6 +39,9 @@ struct Wall {
   // Sums over the wall's contacts, rebuilt every cycle
   Vec3 force;   // [N] total contact force on the wall
   Vec3 moment;  // [N m] about rotation_center
+  double normal_force = 0.0;     // [N] Σ of the contacts' normal force components (compression > 0)
+  double normal_stiffness = 0.0; // [N/m] Σ of the contacts' normal stiffnesses (servo gain)
+  std::size_t active_contacts = 0;
 };
 
 // Where a ball touches a wall: unit normal from the ball centre towards the wall (piece 1 = ball,

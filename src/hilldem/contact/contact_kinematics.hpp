@@ -18,19 +18,36 @@ struct ContactKinematics {
   Vec3 shear_rate() const { return rel_velocity - normal * normal_rate(); }  // δ̇_s [m/s]
 };
 
+// Rotation of the contact plane over one step, spec §1.3: (a) with the change of normal
+// n_old -> n_new, (b) about the normal by the mean spin component mean_spin_n = ½(ω1+ω2)·n_new
+// [rad/s] over dt [s]. Computed once per contact and step, applied to every stored vector.
+struct PlaneRotation {
+  Vec3 tilt;      // n_old × n_new
+  Vec3 twist;     // n_new ω̄_n Δt
+  Vec3 normal;    // n_new
+  PlaneRotation(const Vec3& n_old, const Vec3& n_new, double mean_spin_n, double dt)
+      : tilt(cross(n_old, n_new)), twist(n_new * (mean_spin_n * dt)), normal(n_new) {}
+  // (a) and (b) only: first-order rotation, no renormalisation (used for reported quantities).
+  Vec3 rotate(const Vec3& f) const {
+    const Vec3 g = f - cross(f, tilt);
+    return g - cross(g, twist);
+  }
+  // (a), (b) and (c): drop any residual normal part and restore the magnitude (stored forces).
+  Vec3 carry(const Vec3& f) const {
+    const double mag2 = norm2(f);
+    if (mag2 == 0.0) return f;
+    Vec3 g = rotate(f);
+    g = g - normal * dot(g, normal);
+    const double g2 = norm2(g);
+    return g2 > 0.0 ? g * std::sqrt(mag2 / g2) : g;
+  }
+};
+
 // Carry a vector stored in the previous contact plane (normal n_old) into the current plane
-// (normal n_new), spec §1.3: (a) rotate with the change of normal, (b) rotate about the normal by the
-// mean spin component mean_spin_n = ½(ω1+ω2)·n_new [rad/s] over dt [s], (c) drop any residual
-// normal part and restore the magnitude.
+// (normal n_new), spec §1.3 steps (a)-(c).
 inline Vec3 carry_into_plane(const Vec3& f, const Vec3& n_old, const Vec3& n_new, double mean_spin_n,
                              double dt) {
-  const double mag2 = norm2(f);
-  if (mag2 == 0.0) return f;
-  Vec3 g = f - cross(f, cross(n_old, n_new));          // (a)
-  g = g - cross(g, n_new * mean_spin_n) * dt;          // (b)
-  g = g - n_new * dot(g, n_new);                       // (c)
-  const double g2 = norm2(g);
-  return g2 > 0.0 ? g * std::sqrt(mag2 / g2) : g;
+  return PlaneRotation(n_old, n_new, mean_spin_n, dt).carry(f);
 }
 
 }  // namespace hilldem

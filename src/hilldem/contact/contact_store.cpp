@@ -20,7 +20,7 @@ void ContactStore::append_new(const ContactKey& k, ImageCode img, int rule_index
   normal.push_back(n);
   moisture.push_back(Moisture::Dry);  // new contacts start dry (spec §2.5)
   gap.push_back(0.0);
-  point.emplace_back();
+  torque.emplace_back();
   force.emplace_back();
   normal_force.push_back(0.0);
   moisture_force.push_back(0.0);

@@ -46,7 +46,7 @@ class ContactStore {
 
   // Results of the last force-displacement pass
   std::vector<double> gap;             // g_c [m]
-  std::vector<Vec3> point;             // x_c [m]
+  std::vector<Vec3> torque;            // n̂_c × F_c [N]: the moment on ball b is −(R_b + g_c/2)·torque
   std::vector<Vec3> force;             // F_c on piece 2 [N]
   std::vector<double> normal_force;    // F_n (linear) or F^s_n (hill) [N], compression positive
   std::vector<double> moisture_force;  // F^m [N] ≤ 0
@@ -66,7 +66,7 @@ class ContactStore {
     f(self.linear_map, other.linear_map); f(self.hill_map, other.hill_map);
     f(self.shear_state, other.shear_state); f(self.shear_disp, other.shear_disp);
     f(self.normal, other.normal); f(self.moisture, other.moisture);
-    f(self.gap, other.gap); f(self.point, other.point); f(self.force, other.force);
+    f(self.gap, other.gap); f(self.torque, other.torque); f(self.force, other.force);
     f(self.normal_force, other.normal_force); f(self.moisture_force, other.moisture_force);
     f(self.shear_force, other.shear_force); f(self.trial_shear, other.trial_shear);
     f(self.active, other.active); f(self.k_tran, other.k_tran); f(self.k_shear, other.k_shear);
@@ -90,7 +90,7 @@ class ContactStore {
   void remove(std::size_t i) {
     exists[i] = 0;
     active[i] = 0;
-    shear_state[i] = shear_disp[i] = force[i] = shear_force[i] = Vec3{};
+    shear_state[i] = shear_disp[i] = force[i] = shear_force[i] = torque[i] = Vec3{};
     normal_force[i] = moisture_force[i] = trial_shear[i] = k_tran[i] = k_shear[i] = 0.0;
     moisture[i] = Moisture::Dry;
   }

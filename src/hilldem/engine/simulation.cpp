@@ -47,6 +47,7 @@ double Simulation::skin() const {
 void Simulation::step_once() {
   if (!forces_ready_) update_forces();
   const double dt = next_timestep();
+  for (const auto& control : controllers) control(*this, dt);  // servos set wall velocities
   advance_balls(balls, MotionSettings{settings.gravity, settings.local_damping}, dt);  // spec §1.2 steps 1-2
   for (Wall& w : walls.walls) {
     // Bound on how far any point of the wall moved (for the neighbour-list check).
@@ -223,69 +224,92 @@ void Simulation::rebuild(double proximity) {
 void Simulation::force_pass(double dt) {
   const std::size_t rows = contacts.size();
   const double proximity = settings.proximity;
+  const bool want_stiffness = settings.auto_timestep;
+  const PeriodicBox& box = settings.box;
+  const Vec3* pos = balls.position.data();
+  const double* rad = balls.radius.data();
   bool bad = false;
   std::size_t bad_row = 0;
 #pragma omp parallel for schedule(static) if (rows > kParallelMin)
   for (std::size_t c = 0; c < rows; ++c) {
-    const ContactGeometry g = geometry(c);
-    if (!contacts.exists[c]) {
-      if (!g.valid || g.gap > proximity) continue;  // a neighbour pair, not a contact
-      contacts.create(c, g.normal);                   // created by proximity
-    }
-    const ContactKey& key = contacts.key[c];
+    const ContactKey key = contacts.key[c];
     const std::size_t a = key.a;
     const bool ball2 = key.kind == ContactKind::BallBall;
+    const Vec3 x1 = pos[a];
+    const double r1 = rad[a];
+
+    // Geometry (spec §1.1). Neighbour pairs that are not contacts are rejected before any sqrt.
+    Vec3 normal;
+    double gap;
+    if (ball2) {
+      Vec3 x2 = pos[key.b];
+      if (contacts.image[c] != kNoImage) x2 += image_shift(contacts.image[c], box);
+      const Vec3 d = x2 - x1;
+      const double dist2 = norm2(d);
+      const double rsum = r1 + rad[key.b];
+      if (!contacts.exists[c]) {
+        const double reach = rsum + proximity;
+        if (dist2 > reach * reach) continue;  // a neighbour pair, not a contact
+      }
+      const double dist = std::sqrt(dist2);
+      normal = dist > 0.0 ? d / dist : contacts.normal[c];  // coincident centres: keep the old normal
+      gap = dist - rsum;
+    } else {
+      const auto touch = wall_touch(walls.walls[key.b], x1, r1);
+      if (!touch && !contacts.exists[c]) continue;
+      normal = touch ? touch->normal : contacts.normal[c];
+      gap = touch ? touch->gap : std::numeric_limits<double>::infinity();
+      if (!contacts.exists[c] && gap > proximity) continue;
+    }
+    if (!contacts.exists[c]) contacts.create(c, normal);  // created by proximity
+    const double arm1 = r1 + 0.5 * gap;                   // |x_c − x_1|
+    const Vec3 point = x1 + normal * arm1;                // x_c, centre of the gap/overlap
 
     // Relative velocity of the material points at x_c (spec §1.2) and the mean spin about n̂_c.
-    const Vec3 v1 = balls.velocity[a] + cross(balls.spin[a], g.point - balls.position[a]);
+    const Vec3 v1 = balls.velocity[a] + cross(balls.spin[a], normal * arm1);
     Vec3 v2, spin2;
     if (ball2) {
-      const Vec3 x2 = g.point + g.normal * (balls.radius[key.b] + 0.5 * g.gap);  // centre of (the image of) ball 2
-      v2 = balls.velocity[key.b] + cross(balls.spin[key.b], g.point - x2);
       spin2 = balls.spin[key.b];
+      v2 = balls.velocity[key.b] - cross(spin2, normal * (rad[key.b] + 0.5 * gap));
     } else {
-      v2 = wall_point_velocity(walls.walls[key.b], g.point);
+      v2 = wall_point_velocity(walls.walls[key.b], point);
       spin2 = walls.walls[key.b].spin;
     }
-    const double mean_spin_n = 0.5 * dot(balls.spin[a] + spin2, g.normal);
-    const Vec3 n_old = contacts.normal[c];
-    const ContactKinematics kin{g.normal, g.gap, v2 - v1, dt};
+    const PlaneRotation rotation(contacts.normal[c], normal, 0.5 * dot(balls.spin[a] + spin2, normal), dt);
+    const ContactKinematics kin{normal, gap, v2 - v1, dt};
 
     Vec3 force, shear;
     double fn = 0.0, fm = 0.0, trial = 0.0;
     bool active = false;
     StiffnessEstimate stiff;
-    if (contacts.model[c] == ModelKind::Linear) {
-      const LinearState prev{carry_into_plane(contacts.shear_state[c], n_old, g.normal, mean_spin_n, dt)};
-      const LinearResult r = linear_force(contacts.linear_params[c], contacts.linear_map[c], kin, prev);
-      contacts.shear_state[c] = r.state.shear_force;
-      force = r.force, shear = r.shear_force, fn = r.normal_force, trial = r.trial_shear, active = r.active;
-      if (active) stiff = {contacts.linear_map[c].kn, contacts.linear_map[c].ks};
-    } else {
-      const HillState prev{carry_into_plane(contacts.shear_state[c], n_old, g.normal, mean_spin_n, dt),
-                           contacts.moisture[c]};
+    if (contacts.model[c] == ModelKind::Hill) {
+      const HillState prev{rotation.carry(contacts.shear_state[c]), contacts.moisture[c]};
       const HillResult r = hill_force(contacts.hill_params[c], contacts.hill_map[c], kin, prev);
       contacts.shear_state[c] = r.state.shear_hm;
       contacts.moisture[c] = r.state.moisture;
       force = r.force, shear = r.shear_force, fn = r.surface_normal, fm = r.moisture_force;
       trial = r.trial_shear, active = r.active;
-      if (active) stiff = hill_timestep_stiffness(contacts.hill_params[c], contacts.hill_map[c], g.gap);
+      if (active && want_stiffness) stiff = hill_timestep_stiffness(contacts.hill_params[c], contacts.hill_map[c], gap);
+    } else {
+      const LinearState prev{rotation.carry(contacts.shear_state[c])};
+      const LinearResult r = linear_force(contacts.linear_params[c], contacts.linear_map[c], kin, prev);
+      contacts.shear_state[c] = r.state.shear_force;
+      force = r.force, shear = r.shear_force, fn = r.normal_force, trial = r.trial_shear, active = r.active;
+      if (active) stiff = {contacts.linear_map[c].kn, contacts.linear_map[c].ks};
     }
     // Deleted when inactive beyond the proximity distance (a wet contact stays active: spec §2.5).
-    if (!active && g.gap > proximity) {
+    if (!active && gap > proximity) {
       contacts.remove(c);
-      contacts.gap[c] = g.gap;
-      contacts.normal[c] = g.normal;
+      contacts.gap[c] = gap;
+      contacts.normal[c] = normal;
       continue;
     }
-    // Accumulated shear displacement (reported, not used by the laws): carried like the force.
-    contacts.shear_disp[c] = active ? carry_into_plane(contacts.shear_disp[c], n_old, g.normal, mean_spin_n, dt) +
-                                          kin.shear_rate() * dt
-                                    : Vec3{};
-    contacts.normal[c] = g.normal;
-    contacts.gap[c] = g.gap;
-    contacts.point[c] = g.point;
+    // Accumulated shear displacement (reported, not used by the laws): rotated with the plane.
+    contacts.shear_disp[c] = active ? rotation.rotate(contacts.shear_disp[c]) + kin.shear_rate() * dt : Vec3{};
+    contacts.normal[c] = normal;
+    contacts.gap[c] = gap;
     contacts.force[c] = active ? force : Vec3{};
+    contacts.torque[c] = active ? cross(normal, force) : Vec3{};
     contacts.normal_force[c] = fn;
     contacts.moisture_force[c] = fm;
     contacts.shear_force[c] = shear;
@@ -311,34 +335,40 @@ void Simulation::force_pass(double dt) {
 }
 
 void Simulation::collect_forces() {
-  // Force on piece 2 is F_c, on piece 1 it is −F_c (spec conventions); moments about each centre.
+  // Force on piece 2 is F_c, on piece 1 it is −F_c (spec conventions). The contact point lies on
+  // the normal at R + g/2 from either centre, so the moment on either ball is −(R + g/2) n̂ × F_c.
   // Each ball sums its own rows in row order: the same result for any number of threads.
   const std::size_t n = balls.size();
 #pragma omp parallel for schedule(static) if (n > kParallelMin)
   for (std::size_t i = 0; i < n; ++i) {
     Vec3 f, m;
-    const Vec3 x = balls.position[i];
+    const double r = balls.radius[i];
     for (std::uint32_t k = ball_rows_start_[i]; k < ball_rows_start_[i + 1]; ++k) {
       const std::int64_t code = ball_rows_[k];
-      const std::size_t c = static_cast<std::size_t>(std::abs(code) - 1);
+      const std::size_t c = static_cast<std::size_t>(code > 0 ? code - 1 : -code - 1);
       if (!contacts.active[c]) continue;
-      const Vec3 fc = code > 0 ? contacts.force[c] : -contacts.force[c];
-      // Lever arm from the ball centre to x_c; for a periodic image use the arm along the normal.
-      const Vec3 arm = code > 0 ? contacts.point[c] - (contacts.point[c] + contacts.normal[c] *
-                                                                              (balls.radius[i] + 0.5 * contacts.gap[c]))
-                                : contacts.point[c] - x;
-      f += fc;
-      m += cross(arm, fc);
+      if (code > 0) f += contacts.force[c];
+      else f -= contacts.force[c];
+      m -= contacts.torque[c] * (r + 0.5 * contacts.gap[c]);
     }
     balls.contact_force[i] = f;
     balls.contact_moment[i] = m;
   }
-  for (Wall& w : walls.walls) w.force = w.moment = Vec3{};
+  for (Wall& w : walls.walls) {
+    w.force = w.moment = Vec3{};
+    w.normal_force = w.normal_stiffness = 0.0;
+    w.active_contacts = 0;
+  }
   for (std::uint32_t c : wall_rows_) {
     if (!contacts.active[c]) continue;
-    Wall& w = walls.walls[contacts.key[c].b];
+    const ContactKey& k = contacts.key[c];
+    Wall& w = walls.walls[k.b];
+    const Vec3 point = balls.position[k.a] + contacts.normal[c] * (balls.radius[k.a] + 0.5 * contacts.gap[c]);
     w.force += contacts.force[c];
-    w.moment += cross(contacts.point[c] - w.rotation_center, contacts.force[c]);
+    w.moment += cross(point - w.rotation_center, contacts.force[c]);
+    w.normal_force += dot(contacts.force[c], contacts.normal[c]);
+    w.normal_stiffness += contacts.model[c] == ModelKind::Linear ? contacts.linear_map[c].kn : contacts.k_tran[c];
+    ++w.active_contacts;
   }
 }
 

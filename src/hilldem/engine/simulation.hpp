@@ -57,6 +57,9 @@ class Simulation {
 
   // Called after every cycle (histories, progress).
   std::vector<std::function<void(const Simulation&)>> observers;
+  // Called at the start of every cycle with its Δt [s], before the law of motion, with the forces
+  // at t: servos and other controllers set wall or ball velocities here.
+  std::vector<std::function<void(Simulation&, double)>> controllers;
 
   // Run n cycles.
   void cycle(std::int64_t n);
