@@ -136,6 +136,12 @@ void Simulation::rebuild_if_needed() {
     const double half = 0.5 * skin();
     double worst = 0.0;
     for (std::size_t i = 0; i < balls.size(); ++i) worst = std::max(worst, norm2(balls.position[i] - position_at_build_[i]));
+    if (!std::isfinite(worst)) {
+      for (std::size_t i = 0; i < balls.size(); ++i)
+        if (!std::isfinite(norm2(balls.position[i])))
+          throw RunError("ball " + std::to_string(balls.id[i]) + " has a non-finite position at step " +
+                         std::to_string(steps) + ": the run is unstable; reduce the time step");
+    }
     const double ball_travel = std::sqrt(worst);
     // A pair outside the list was farther than `skin` beyond proximity at the rebuild.
     if (ball_travel <= half && ball_travel + wall_travel_ <= 2.0 * half) return;

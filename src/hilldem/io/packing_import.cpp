@@ -73,7 +73,10 @@ Packing parse_lammps(const std::string& text, const std::string& name) {
       continue;
     }
     if (line.find("atoms") != std::string::npos && line.find("types") == std::string::npos) {
-      expected = static_cast<long>(numbers(line.substr(0, line.find("atoms")), name, lineno, 1)[0]);
+      const double count = numbers(line.substr(0, line.find("atoms")), name, lineno, 1)[0];
+      if (!(count >= 0.0 && count <= 5e7 && count == std::floor(count)))
+        throw InputError(fmt::format("{}: line {}: the atom count must be a whole number in [0, 5e7]; got {}", name, lineno, count));
+      expected = static_cast<long>(count);
     } else if (line.find("xlo xhi") != std::string::npos) {
       const auto v = numbers(line.substr(0, line.find("xlo")), name, lineno, 2);
       p.box_lo.x = v[0], p.box_hi.x = v[1], seen_x = true;

@@ -33,6 +33,7 @@ const char* to_string(StageType t) {
 namespace {
 
 constexpr double kInf = HUGE_VAL;
+constexpr double kMaxBalls = 5e7;  // a guard against typos that would exhaust memory
 const Range kPoisson = Range::open_closed(-1.0, 0.5);    // spec §2.2
 const Range kDampCon = Range::closed_open(0.0, 1.0);      // spec §2.2
 const Range kLocalDamping = Range::closed_open(0.0, 1.0);
@@ -64,7 +65,11 @@ std::uint64_t read_groups(TableReader& t, GroupNames& names) {
   std::uint64_t mask = 0;
   for (const std::string& g : t.strings("groups")) {
     if (g.empty()) t.fail("groups", "group names must not be empty");
-    mask |= names.bit(g);
+    try {
+      mask |= names.bit(g);
+    } catch (const InputError& e) {
+      t.fail("groups", e.what());
+    }
   }
   return mask;
 }
@@ -89,6 +94,9 @@ class Reader {
     for (TableReader& t : root_.tables("history")) read_history(t, sc);
     for (TableReader& t : root_.tables("stage")) read_stage(t, sc);
     root_.finish();
+    if (sc.sim.balls.size() == 0)
+      throw InputError(file_ + ": the scenario has no balls ([[ball]], [[ball_grid]] or [[packing]])");
+    check_hill_moduli(sc.sim);
     return sc;
   }
 
@@ -188,6 +196,12 @@ class Reader {
     std::int64_t id = t.integer("first_id", std::nullopt, 0, INT64_MAX);
     const Vec3 origin = t.vec3("origin", std::nullopt, Range::any(), "[m]");
     const Vec3 counts = t.vec3("counts", std::nullopt, Range::closed(1, 1000), "[-]");
+    if (counts.x != std::floor(counts.x) || counts.y != std::floor(counts.y) || counts.z != std::floor(counts.z))
+      t.fail("counts", "must be whole numbers [nx, ny, nz]");
+    if (counts.x * counts.y * counts.z > kMaxBalls)
+      t.fail("counts", fmt::format("at most {:g} balls in all; got {:g}", kMaxBalls, counts.x * counts.y * counts.z));
+    if (static_cast<double>(id) + counts.x * counts.y * counts.z > 9.2e18)
+      t.fail("first_id", "ids would overflow a 64-bit integer");
     const double spacing = t.real("spacing", std::nullopt, Range::positive(), "[m]");
     t.finish();
     for (int k = 0; k < static_cast<int>(counts.z); ++k)
@@ -206,20 +220,28 @@ class Reader {
     const Material& m = material(t);
     const std::uint64_t groups = read_groups(t, sim.groups);
     const auto rep = t.integers("replicate");
-    if (!rep.empty() && (rep.size() != 3 || rep[0] < 1 || rep[1] < 1 || rep[2] < 1 || rep[0] * rep[1] * rep[2] > 10000))
-      t.fail("replicate", "must be [nx, ny, nz] with each >= 1 (at most 10000 copies)");
+    if (!rep.empty() && (rep.size() != 3 || rep[0] < 1 || rep[1] < 1 || rep[2] < 1 || rep[0] > 10000 ||
+                         rep[1] > 10000 || rep[2] > 10000 || rep[0] * rep[1] * rep[2] > 10000))
+      t.fail("replicate", "must be [nx, ny, nz] with each >= 1 (at most 10000 copies in all)");
     std::int64_t next_id = 1;
     for (std::int64_t id : ids_) next_id = std::max(next_id, id + 1);
     std::int64_t id = t.integer("first_id", next_id, 0, INT64_MAX);
     t.finish();
     const std::filesystem::path base = std::filesystem::path(file_).parent_path();
     const std::string path = std::filesystem::path(file).is_absolute() ? file : (base / file).string();
-    Packing p = read_packing(path, format == "lammps" ? PackingFormat::Lammps : PackingFormat::Xyzr);
+    Packing p;
+    try {
+      p = read_packing(path, format == "lammps" ? PackingFormat::Lammps : PackingFormat::Xyzr);
+    } catch (const InputError& e) {
+      t.fail("file", e.what());
+    }
     if (!rep.empty()) {
       const int n[3] = {static_cast<int>(rep[0]), static_cast<int>(rep[1]), static_cast<int>(rep[2])};
       if (!p.has_box) t.fail("replicate", "needs a packing with a box (format \"lammps\")");
       replicate(p, n);
     }
+    if (static_cast<double>(p.balls.size()) + static_cast<double>(sim.balls.size()) > kMaxBalls)
+      t.fail("file", fmt::format("at most {:g} balls in all", kMaxBalls));
     if (p.has_box && !box_given_) {
       sim.settings.box.lo = p.box_lo;
       sim.settings.box.hi = p.box_hi;
@@ -235,6 +257,22 @@ class Reader {
       b.pois_ratio = m.pois_ratio;
       b.groups = groups;
       add_ball(t, sim, b);
+    }
+  }
+
+  // The hill model needs E > 0 on both balls (spec §2.4): refuse a material without it when a hill
+  // rule can apply to its balls.
+  void check_hill_moduli(const Simulation& sim) {
+    for (const ModelRule& r : sim.table.rules) {
+      if (r.model != ModelKind::Hill) continue;
+      for (std::size_t i = 0; i < sim.balls.size(); ++i) {
+        const bool in_rule = (r.groups1 == 0 || (sim.balls.groups[i] & r.groups1)) ||
+                             (r.groups2 == 0 || (sim.balls.groups[i] & r.groups2));
+        if (in_rule && !(sim.balls.young_mod[i] > 0.0))
+          throw InputError(fmt::format("{}: key 'material.young_mod': ball {} has young_mod = 0 but the hill rule '{}' "
+                                       "can apply to it; the hill model needs young_mod in (0, inf) [Pa]",
+                                       file_, sim.balls.id[i], r.name));
+      }
     }
   }
 
@@ -369,6 +407,7 @@ class Reader {
       r.linear.fric = t.real("fric", 0.0, Range::closed(0.0, kInf), "[-]");
     }
     t.finish();
+    if (sim.table.rules.size() >= 30000) t.fail("name", "at most 30000 assignment rules");
     sim.table.rules.push_back(r);
   }
 
@@ -515,6 +554,9 @@ Scenario load_scenario(const std::string& text, const std::string& file) {
 }
 
 Scenario load_scenario_file(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
+    throw InputError(path + ": not a regular file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open the scenario file");
   std::ostringstream ss;

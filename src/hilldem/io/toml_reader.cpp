@@ -1,5 +1,7 @@
 #include "hilldem/io/toml_reader.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fmt/format.h>
 #include <sstream>
@@ -15,6 +17,11 @@ std::string show(const toml::node& n) {
   if (n.is_array()) {
     os << *n.as_array();
     return os.str();
+  }
+  if (const auto d = n.value_exact<double>()) {  // shortest form: 0.6, not 0.59999...; 10.0 stays a float
+    std::string s = fmt::format("{}", *d);
+    if (s.find_first_of(".eEni") == std::string::npos) s += ".0";
+    return s;
   }
   n.visit([&](auto&& v) { os << v; });
   return os.str();
@@ -89,6 +96,7 @@ double TableReader::real(const std::string& key, std::optional<double> def, Rang
   double v;
   if (auto f = n->value<double>(); f && (n->is_floating_point() || n->is_integer())) v = *f;
   else fail(key, fmt::format("must be a number in {} {}; got {}", range.text(), unit, show(*n)));
+  if (!std::isfinite(v)) fail(key, fmt::format("must be a finite number in {} {}; got {}", range.text(), unit, show(*n)));
   if (!range.contains(v)) fail(key, fmt::format("must be in {} {}; got {}", range.text(), unit, show(*n)));
   return v;
 }
@@ -236,7 +244,45 @@ void TableReader::finish() const {
   }
 }
 
+namespace {
+// toml++ parses recursively: refuse absurd nesting (arrays, inline tables, dotted keys) before it
+// can exhaust the stack. Strings are skipped; the limits are far above any real scenario.
+void check_nesting(const std::string& text, const std::string& file) {
+  constexpr int kMaxDepth = 64, kMaxDots = 64;
+  int depth = 0, dots = 0, line = 1;
+  char quote = 0;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '\n') {
+      ++line;
+      dots = 0;
+      if (quote == '"' || quote == '\'') quote = 0;  // single-line strings end here (bad TOML anyway)
+      continue;
+    }
+    if (quote) {
+      if (c == '\\' && quote == '"') ++i;
+      else if (c == quote) quote = 0;
+      continue;
+    }
+    if (c == '#') {
+      while (i + 1 < text.size() && text[i + 1] != '\n') ++i;
+    } else if (c == '"' || c == '\'') {
+      quote = c;
+    } else if (c == '[' || c == '{') {
+      if (++depth > kMaxDepth)
+        throw InputError(fmt::format("{}: line {}: arrays or tables nested deeper than {} levels", file, line, kMaxDepth));
+    } else if (c == ']' || c == '}') {
+      depth = std::max(0, depth - 1);
+    } else if (c == '.' && !(i > 0 && std::isdigit(static_cast<unsigned char>(text[i - 1])))) {
+      if (++dots > kMaxDots)
+        throw InputError(fmt::format("{}: line {}: a dotted key with more than {} parts", file, line, kMaxDots));
+    }
+  }
+}
+}  // namespace
+
 toml::table parse_toml(const std::string& text, const std::string& file) {
+  check_nesting(text, file);
   try {
     return toml::parse(text, file);
   } catch (const toml::parse_error& e) {
