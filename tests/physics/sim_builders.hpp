@@ -1,6 +1,8 @@
 // Small helpers that build simulations in code for the physics tests.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <random>
 
 #include "hilldem/engine/simulation.hpp"
@@ -41,14 +43,26 @@ inline ModelRule linear_wall_rule(double emod, double fric) {
   return r;
 }
 
-// A loose random cloud of n balls (radii 2-3 mm) in a 40 mm cube with overlaps, random velocities
-// and spins, bounded by six planes.
-inline Simulation random_box(int n, unsigned seed, bool walls = true) {
+// A random cloud of n balls (radii 2-3 mm, scaled to fit) in a cube of side `side` [m] whose overlaps
+// are small (at most 2 % of the smaller radius), with random velocities and spins, bounded by six planes.
+inline Simulation random_box(int n, unsigned seed, bool walls = true, double side = 40e-3) {
   Simulation sim;
   std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> pos(3e-3, 37e-3), rad(2e-3, 3e-3), vel(-0.5, 0.5), spin(-50, 50);
-  for (int i = 0; i < n; ++i) {
-    BallInit b = granite(i + 1, {pos(rng), pos(rng), pos(rng)}, rad(rng), {vel(rng), vel(rng), vel(rng)});
+  // Shrink the radii so that n balls fill about 30 % of the cube.
+  const double scale = std::min(1.0, std::cbrt(0.3 * side * side * side / (n * 4.19 * 2.5e-3 * 2.5e-3 * 2.5e-3)));
+  std::uniform_real_distribution<double> pos(0.0, 1.0), rad(2e-3 * scale, 3e-3 * scale), vel(-0.5, 0.5), spin(-50, 50);
+  std::vector<Vec3> placed;
+  std::vector<double> radii;
+  while (static_cast<int>(placed.size()) < n) {
+    const double r = rad(rng);
+    const Vec3 x{r + (side - 2 * r) * pos(rng), r + (side - 2 * r) * pos(rng), r + (side - 2 * r) * pos(rng)};
+    bool ok = true;
+    for (std::size_t k = 0; k < placed.size() && ok; ++k)
+      ok = norm(placed[k] - x) > r + radii[k] - 0.02 * std::min(r, radii[k]);
+    if (!ok) continue;
+    placed.push_back(x);
+    radii.push_back(r);
+    BallInit b = granite(static_cast<std::int64_t>(placed.size()), x, r, {vel(rng), vel(rng), vel(rng)});
     b.spin = {spin(rng), spin(rng), spin(rng)};
     sim.balls.add(b);
   }
@@ -56,12 +70,12 @@ inline Simulation random_box(int n, unsigned seed, bool walls = true) {
   sim.table.rules.push_back(linear_wall_rule(500e6, 0.4));
   if (walls) {
     for (int d = 0; d < 3; ++d)
-      for (int side = 0; side < 2; ++side) {
+      for (int upper = 0; upper < 2; ++upper) {
         Wall w;
-        w.name = "plane" + std::to_string(2 * d + side);
+        w.name = "plane" + std::to_string(2 * d + upper);
         w.shape = WallShape::Plane;
-        w.point[d] = side ? 40e-3 : 0.0;
-        w.normal[d] = side ? -1.0 : 1.0;
+        w.point[d] = upper ? side : 0.0;
+        w.normal[d] = upper ? -1.0 : 1.0;
         sim.walls.add(w);
       }
   }

@@ -28,12 +28,12 @@ struct PlaneRotation {
   PlaneRotation(const Vec3& n_old, const Vec3& n_new, double mean_spin_n, double dt)
       : tilt(cross(n_old, n_new)), twist(n_new * (mean_spin_n * dt)), normal(n_new) {}
   // (a) and (b) only: first-order rotation, no renormalisation (used for reported quantities).
-  Vec3 rotate(const Vec3& f) const {
+  HILLDEM_INLINE Vec3 rotate(const Vec3& f) const {
     const Vec3 g = f - cross(f, tilt);
     return g - cross(g, twist);
   }
   // (a), (b) and (c): drop any residual normal part and restore the magnitude (stored forces).
-  Vec3 carry(const Vec3& f) const {
+  HILLDEM_INLINE Vec3 carry(const Vec3& f) const {
     const double mag2 = norm2(f);
     if (mag2 == 0.0) return f;
     Vec3 g = rotate(f);

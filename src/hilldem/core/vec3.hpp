@@ -4,6 +4,10 @@
 
 #include <cmath>
 
+// Force inlining of the small functions of the per-contact hot path (force laws, plane rotation):
+// the compiler otherwise keeps some out of line and passes their result structs through memory.
+#define HILLDEM_INLINE inline __attribute__((always_inline))
+
 namespace hilldem {
 
 struct Vec3 {

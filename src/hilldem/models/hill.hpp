@@ -65,7 +65,7 @@ inline HillMapping hill_mapping(const HillParams& p, const HillBodies& b) {
 }
 
 // Eq. 12 [R]: moisture force [N] (≤ 0, suction) of a wet contact at gap g [m].
-inline double hill_moisture_force(double suction, double r_o, double gap) {
+HILLDEM_INLINE double hill_moisture_force(double suction, double r_o, double gap) {
   const double f_max = -suction * std::numbers::pi * r_o * r_o;  // F^m_max = −ψ π R_o²
   const double s_cr = kHillCriticalGapFactor * r_o;
   if (gap <= 0.0) return f_max;
@@ -74,7 +74,7 @@ inline double hill_moisture_force(double suction, double r_o, double gap) {
 }
 
 // Rupture gap 2 s_cr [m]: a wet contact at or beyond it ruptures (M = 1).
-inline double hill_rupture_gap(double r_o) { return kHillDecayDivisor * kHillCriticalGapFactor * r_o; }
+HILLDEM_INLINE double hill_rupture_gap(double r_o) { return kHillDecayDivisor * kHillCriticalGapFactor * r_o; }
 
 struct HillState {
   Vec3 shear_hm;                       // F^h_s [N], Hertz-Mindlin shear force carried between steps
@@ -92,11 +92,11 @@ struct HillResult {
 };
 
 // A hill contact is active if it is wet or overlapping (spec §2.5).
-inline bool hill_active(Moisture m, double gap) { return m == Moisture::Wet || gap <= 0.0; }
+HILLDEM_INLINE bool hill_active(Moisture m, double gap) { return m == Moisture::Wet || gap <= 0.0; }
 
 // Force-displacement law, spec §2.6 steps 1-3. previous.shear_hm must already be carried into the
 // current plane (carry_into_plane, §1.3).
-inline HillResult hill_force(const HillParams& p, const HillMapping& m, const ContactKinematics& k,
+HILLDEM_INLINE HillResult hill_force(const HillParams& p, const HillMapping& m, const ContactKinematics& k,
                              const HillState& previous) {
   HillResult r;
   r.state = previous;
@@ -144,7 +144,7 @@ struct StiffnessEstimate {
 };
 
 // Eqs. 19-21: tangent stiffnesses for the time-step estimate, inflated for the dashpots.
-inline StiffnessEstimate hill_timestep_stiffness(const HillParams& p, const HillMapping& m, double gap) {
+HILLDEM_INLINE StiffnessEstimate hill_timestep_stiffness(const HillParams& p, const HillMapping& m, double gap) {
   double overlap = -gap;
   if (overlap <= 0.0) overlap = kHillTimestepOverlapFactor * m.r_o;
   const double root2 = std::sqrt(overlap);

@@ -45,7 +45,7 @@ struct LinearResult {
 };
 
 // previous.shear_force must already be carried into the current plane (carry_into_plane).
-inline LinearResult linear_force(const LinearParams& p, const LinearMapping& m, const ContactKinematics& k,
+HILLDEM_INLINE LinearResult linear_force(const LinearParams& p, const LinearMapping& m, const ContactKinematics& k,
                                  const LinearState& previous) {
   LinearResult r;
   const double overlap = k.overlap();

@@ -1,0 +1,192 @@
+// Issue #4 features: periodic boundaries, packing import with replication, thread-count
+// independence (bitwise), neighbour-list rebuilds that do not change results, density scaling.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "hilldem/contact/cell_grid.hpp"
+#include "hilldem/core/error.hpp"
+#include "hilldem/io/packing_import.hpp"
+#include "sim_builders.hpp"
+
+namespace hilldem {
+namespace {
+
+using namespace hilldem::testing;
+
+// Brute-force periodic pair search: every pair (i<j) with its nearest image.
+std::vector<std::pair<std::uint32_t, std::uint32_t>> periodic_brute(const std::vector<Vec3>& x, const std::vector<double>& r,
+                                                                   double reach, const PeriodicBox& box) {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> out;
+  for (std::uint32_t i = 0; i < x.size(); ++i)
+    for (std::uint32_t j = i + 1; j < x.size(); ++j) {
+      const Vec3 xj = x[j] + image_shift(nearest_image(x[i], x[j], box), box);
+      const double lim = r[i] + r[j] + reach;
+      if (norm2(xj - x[i]) <= lim * lim) out.emplace_back(i, j);
+    }
+  return out;
+}
+
+TEST(Periodic, CellGridMatchesBruteForceWithImages) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0), rad(1e-3, 2e-3);
+  PeriodicBox box;
+  box.periodic[0] = box.periodic[1] = true;
+  box.lo = {0, 0, 0};
+  box.hi = {0.03, 0.025, 0.02};
+  std::vector<Vec3> x;
+  std::vector<double> r;
+  for (int i = 0; i < 1500; ++i) {
+    x.push_back({u(rng) * 0.03, u(rng) * 0.025, u(rng) * 0.02});
+    r.push_back(rad(rng));
+  }
+  const auto found = find_pair_candidates(x, r, 0.3e-3, box);
+  const auto expected = periodic_brute(x, r, 0.3e-3, box);
+  ASSERT_EQ(found.size(), expected.size());
+  std::size_t across = 0;
+  for (std::size_t k = 0; k < found.size(); ++k) {
+    EXPECT_EQ(found[k].i, expected[k].first);
+    EXPECT_EQ(found[k].j, expected[k].second);
+    EXPECT_EQ(found[k].image, nearest_image(x[found[k].i], x[found[k].j], box));
+    across += found[k].image != kNoImage;
+  }
+  EXPECT_GT(across, 20u);  // pairs across the periodic faces were found
+}
+
+TEST(Periodic, TooSmallBoxIsRefused) {
+  PeriodicBox box;
+  box.periodic[0] = true;
+  box.hi = {0.01, 1, 1};
+  EXPECT_THROW(find_pair_candidates({{0.001, 0, 0}, {0.005, 0, 0}}, {2e-3, 2e-3}, 0.0, box), InputError);
+}
+
+// Two balls touching across the periodic face x = 0 / x = L push each other apart and the contact
+// carries the same force as the same pair inside the box.
+TEST(Periodic, ContactAcrossTheBoundary) {
+  const double L = 0.1, r = 5e-3, overlap = 2e-5;
+  auto run = [&](bool across) {
+    Simulation sim;
+    const double x1 = across ? r - overlap / 2 : 0.05;
+    const double x2 = across ? L - r + overlap / 2 : 0.05 + 2 * r - overlap;
+    sim.balls.add(granite(1, {x1, 0.05, 0.05}, r));
+    sim.balls.add(granite(2, {x2, 0.05, 0.05}, r));
+    sim.table.rules.push_back(hill_rule(0.4, 0.0));
+    sim.settings.box.periodic[0] = sim.settings.box.periodic[1] = sim.settings.box.periodic[2] = true;
+    sim.settings.box.hi = {L, L, L};
+    sim.update_forces();
+    const long c = sim.find_ball_ball(1, 2);
+    EXPECT_GE(c, 0);
+    return std::make_pair(sim.contacts.normal_force[c], sim.balls.contact_force[0].x);
+  };
+  const auto inside = run(false), across = run(true);
+  EXPECT_GT(inside.first, 0.0);
+  EXPECT_NEAR(across.first, inside.first, 1e-6 * inside.first);
+  EXPECT_LT(inside.second, 0.0);  // ball 1 pushed towards -x ...
+  EXPECT_GT(across.second, 0.0);  // ... and across the boundary, towards +x (its neighbour is the image at x < 0)
+}
+
+// Positions are wrapped into the box and the run stays identical to an equivalent one.
+TEST(Periodic, BallsStayInTheBox) {
+  Simulation sim = random_box(300, 21, /*walls=*/false);
+  sim.settings.box.periodic[0] = sim.settings.box.periodic[1] = sim.settings.box.periodic[2] = true;
+  sim.settings.box.hi = {0.04, 0.04, 0.04};
+  for (std::size_t i = 0; i < sim.balls.size(); ++i) sim.balls.velocity[i] *= 50.0;  // fast: many crossings
+  sim.cycle(2000);
+  for (const Vec3& x : sim.balls.position)
+    for (int d = 0; d < 3; ++d) {
+      EXPECT_GE(x[d], -0.01);  // wrapped at rebuilds: never far outside
+      EXPECT_LE(x[d], 0.05);
+    }
+}
+
+TEST(PackingImport, LammpsDataWithReplication) {
+  const std::string text = R"(LAMMPS data file via write_data
+
+3 atoms
+1 atom types
+
+0 0.1 xlo xhi
+0 0.2 ylo yhi
+0 0.3 zlo zhi
+
+Atoms # sphere
+
+1 1 0.01 2650 0.01 0.02 0.03 0 0 0
+2 1 0.012 2600 0.05 0.02 0.03 0 0 0
+3 1 0.008 2650 0.09 0.15 0.005 0 0 0
+
+Velocities
+
+1 0 0 0 0 0 0
+2 0 0 0 0 0 0
+3 0 0 0 0 0 0
+)";
+  Packing p = parse_packing(text, "bed.data", PackingFormat::Lammps);
+  ASSERT_EQ(p.balls.size(), 3u);
+  EXPECT_DOUBLE_EQ(p.balls[1].radius, 0.006);
+  EXPECT_DOUBLE_EQ(p.balls[1].density, 2600.0);
+  EXPECT_DOUBLE_EQ(p.box_hi.y, 0.2);
+  const int n[3] = {3, 2, 1};
+  replicate(p, n);
+  ASSERT_EQ(p.balls.size(), 18u);
+  EXPECT_DOUBLE_EQ(p.box_hi.x, 0.3);
+  EXPECT_DOUBLE_EQ(p.box_hi.y, 0.4);
+  EXPECT_DOUBLE_EQ(p.balls[17].position.x, 0.09 + 0.2);
+  EXPECT_DOUBLE_EQ(p.balls[17].position.y, 0.15 + 0.2);
+}
+
+TEST(PackingImport, XyzrAndErrors) {
+  Packing p = parse_packing("# x y z r\n0 0 0 0.001\n0.01 0 0 0.002 # comment\n", "p.txt", PackingFormat::Xyzr);
+  ASSERT_EQ(p.balls.size(), 2u);
+  EXPECT_FALSE(p.has_box);
+  EXPECT_THROW(parse_packing("0 0 0\n", "p.txt", PackingFormat::Xyzr), InputError);
+  EXPECT_THROW(parse_packing("0 0 0 -1\n", "p.txt", PackingFormat::Xyzr), InputError);
+  EXPECT_THROW(parse_packing("0 0 nan 1\n", "p.txt", PackingFormat::Xyzr), InputError);
+  EXPECT_THROW(parse_packing("t\n\n2 atoms\n0 1 xlo xhi\n0 1 ylo yhi\n0 1 zlo zhi\n\nAtoms # sphere\n\n1 1 0.01 2650 0 0 0\n",
+                             "d.data", PackingFormat::Lammps),
+               InputError);  // the header says 2 atoms, the section has 1
+  const int n[3] = {2, 1, 1};
+  EXPECT_THROW(replicate(p, n), InputError);  // no box
+}
+
+// Bitwise identical positions after N steps for 1 and 2 threads (issue #4 acceptance).
+TEST(Threads, OneAndTwoThreadsGiveBitwiseIdenticalResults) {
+  auto run = [](int threads) {
+    omp_set_num_threads(threads);
+    Simulation sim = random_box(4000, 9, true, 0.1);  // above the parallel threshold
+    sim.settings.gravity = {0, 0, -9.81};
+    sim.settings.local_damping = 0.3;
+    sim.settings.auto_timestep = true;
+    sim.make_wet(20e3, 0.5e-3);
+    sim.cycle(150);
+    return std::make_pair(sim.balls.position, sim.balls.spin);
+  };
+  const auto one = run(1), two = run(2);
+  omp_set_num_threads(omp_get_num_procs());
+  ASSERT_EQ(one.first.size(), two.first.size());
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < one.first.size(); ++i) differ += !(one.first[i] == two.first[i]) || !(one.second[i] == two.second[i]);
+  EXPECT_EQ(differ, 0u);
+}
+
+// The skin is an optimisation only: a run with a large skin (few rebuilds) equals one that
+// rebuilds every step, up to round-off in the order of nothing (same rows, same order).
+TEST(NeighbourList, SkinDoesNotChangeResults) {
+  auto run = [](double skin) {
+    Simulation sim = random_box(500, 13);
+    sim.settings.skin = skin;
+    sim.settings.gravity = {0, 0, -9.81};
+    sim.cycle(400);
+    return std::make_pair(sim.balls.position, sim.rebuilds());
+  };
+  const auto small = run(1e-9), large = run(2e-3);
+  EXPECT_GT(small.second, 5 * large.second);  // many more rebuilds
+  double worst = 0.0;
+  for (std::size_t i = 0; i < small.first.size(); ++i) worst = std::max(worst, norm(small.first[i] - large.first[i]));
+  EXPECT_LT(worst, 1e-12);
+}
+
+}  // namespace
+}  // namespace hilldem
