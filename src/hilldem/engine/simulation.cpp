@@ -48,7 +48,24 @@ void Simulation::step_once() {
   if (!forces_ready_) update_forces();
   const double dt = next_timestep();
   for (const auto& control : controllers) control(*this, dt);  // servos set wall velocities
-  advance_balls(balls, MotionSettings{settings.gravity, settings.local_damping}, dt);  // spec §1.2 steps 1-2
+  const double* m_scaled = nullptr;
+  const double* i_scaled = nullptr;
+  if (settings.density_scaling) {
+    const std::size_t n = balls.size();
+    scaled_mass_.resize(n);
+    scaled_inertia_.resize(n);
+    const double want = dt / settings.timestep_safety;  // Δt/f
+#pragma omp parallel for schedule(static) if (n > kParallelMin)
+    for (std::size_t i = 0; i < n; ++i) {
+      double k_tran, k_rot;
+      ball_stiffness(i, k_tran, k_rot);
+      scaled_mass_[i] = std::max(balls.mass[i], k_tran * want * want);
+      scaled_inertia_[i] = std::max(balls.inertia[i], k_rot * want * want);
+    }
+    m_scaled = scaled_mass_.data();
+    i_scaled = scaled_inertia_.data();
+  }
+  advance_balls(balls, MotionSettings{settings.gravity, settings.local_damping}, dt, m_scaled, i_scaled);  // §1.2 steps 1-2
   for (Wall& w : walls.walls) {
     // Bound on how far any point of the wall moved (for the neighbour-list check).
     double reach = 0.0;
@@ -230,7 +247,7 @@ void Simulation::rebuild(double proximity) {
 void Simulation::force_pass(double dt) {
   const std::size_t rows = contacts.size();
   const double proximity = settings.proximity;
-  const bool want_stiffness = settings.auto_timestep;
+  const bool want_stiffness = settings.auto_timestep || settings.density_scaling;
   const PeriodicBox& box = settings.box;
   const Vec3* pos = balls.position.data();
   const double* rad = balls.radius.data();
@@ -378,6 +395,18 @@ void Simulation::collect_forces() {
   }
 }
 
+void Simulation::ball_stiffness(std::size_t i, double& k_tran, double& k_rot) const {
+  k_tran = k_rot = 0.0;
+  if (i + 1 >= ball_rows_start_.size()) return;  // a ball added since the last rebuild: no contacts yet
+  for (std::uint32_t k = ball_rows_start_[i]; k < ball_rows_start_[i + 1]; ++k) {
+    const std::size_t c = static_cast<std::size_t>(std::abs(ball_rows_[k]) - 1);
+    if (!contacts.active[c]) continue;
+    const double arm = balls.radius[i] + 0.5 * contacts.gap[c];  // |x_c − x| (the contact point is on the normal)
+    k_tran += contacts.k_tran[c];
+    k_rot += contacts.k_shear[c] * arm * arm;
+  }
+}
+
 double Simulation::estimate_timestep() const {
   // Per-body sums of the contact-returned stiffnesses (spec §4): k_tran = Σ(k̂_n + k̂_s),
   // k_rot = Σ k̂_s |x_c − x|². Δt_crit = min(√(m/k_tran), √(I/k_rot)). The stiffnesses were stored
@@ -386,14 +415,8 @@ double Simulation::estimate_timestep() const {
   double crit = std::numeric_limits<double>::infinity();
 #pragma omp parallel for schedule(static) reduction(min : crit) if (n > kParallelMin)
   for (std::size_t i = 0; i < n; ++i) {
-    double k_tran = 0.0, k_rot = 0.0;
-    for (std::uint32_t k = ball_rows_start_[i]; k < ball_rows_start_[i + 1]; ++k) {
-      const std::size_t c = static_cast<std::size_t>(std::abs(ball_rows_[k]) - 1);
-      if (!contacts.active[c]) continue;
-      const double arm = balls.radius[i] + 0.5 * contacts.gap[c];  // |x_c − x| (the contact point is on the normal)
-      k_tran += contacts.k_tran[c];
-      k_rot += contacts.k_shear[c] * arm * arm;
-    }
+    double k_tran, k_rot;
+    ball_stiffness(i, k_tran, k_rot);
     if (k_tran > 0.0) crit = std::min(crit, std::sqrt(balls.mass[i] / k_tran));
     if (k_rot > 0.0) crit = std::min(crit, std::sqrt(balls.inertia[i] / k_rot));
   }

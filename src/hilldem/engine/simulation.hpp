@@ -31,6 +31,10 @@ struct SimulationSettings {
   double timestep_max = 1e-4;    // [s] Δt used when no contact reports a stiffness yet
   double proximity = 0.0;        // [m] contacts are created for gaps ≤ proximity
   double skin = 0.0;             // [m] neighbour-list skin; 0 = 0.1 × mean ball diameter
+  // Density scaling (as PFC): with a fixed Δt, each ball's inertial mass and inertia are raised to
+  // what that Δt needs for stability, m' = max(m, k_tran (Δt/f)²), I' = max(I, k_rot (Δt/f)²).
+  // Static equilibria are unchanged; dynamics are not physical. For quasi-static runs only.
+  bool density_scaling = false;
   PeriodicBox box;               // periodic directions and their period [lo, hi) [m]
 };
 
@@ -115,6 +119,8 @@ class Simulation {
   void force_pass(double dt);
   void collect_forces();
   void compute_mapping(ContactStore& store, std::size_t c) const;
+  // Σ over ball i's active contacts: k_tran = Σ(k̂_n + k̂_s) [N/m], k_rot = Σ k̂_s |x_c − x|² [N m].
+  void ball_stiffness(std::size_t i, double& k_tran, double& k_rot) const;
   std::uint64_t piece2_groups(const ContactKey& k) const;
   double skin() const;
   void wrap_positions();
@@ -128,6 +134,7 @@ class Simulation {
   std::vector<std::uint32_t> ball_rows_start_;  // CSR: rows of ball i are ball_rows_[start[i]..start[i+1])
   std::vector<std::int64_t> ball_rows_;      // row r as +(r+1) when the ball is piece 2, −(r+1) piece 1
   std::vector<std::uint32_t> wall_rows_;     // rows of ball-wall pairs
+  std::vector<double> scaled_mass_, scaled_inertia_;  // density scaling [kg], [kg m²]
 };
 
 }  // namespace hilldem

@@ -118,6 +118,9 @@ class Reader {
     s.timestep_max = t->real("timestep_max", 1e-4, Range::open(0.0, 1.0), "[s]");
     s.proximity = t->real("proximity", 0.0, Range::closed(0.0, kInf), "[m]");
     s.skin = t->real("skin", 0.0, Range::closed(0.0, kInf), "[m] (0: 0.1 x mean diameter)");
+    s.density_scaling = t->boolean("density_scaling", false);
+    if (s.density_scaling && s.auto_timestep)
+      t->fail("density_scaling", "needs a fixed timestep [s] (the masses are scaled to it), not \"auto\"");
     for (const std::string& d : t->strings("periodic")) {
       if (d != "x" && d != "y" && d != "z") t->fail("periodic", "directions must be \"x\", \"y\" or \"z\"; got \"" + d + "\"");
       s.box.periodic[d[0] - 'x'] = true;

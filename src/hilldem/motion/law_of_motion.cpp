@@ -10,7 +10,8 @@ inline double damped(double f, double v, double alpha) {
 }
 }  // namespace
 
-void advance_balls(BallStore& balls, const MotionSettings& s, double dt) {
+void advance_balls(BallStore& balls, const MotionSettings& s, double dt, const double* inertial_mass,
+                   const double* inertial_inertia) {
   const double alpha = s.local_damping;
   const std::size_t n = balls.size();
 #pragma omp parallel for schedule(static) if (n > kParallelMin)
@@ -18,7 +19,8 @@ void advance_balls(BallStore& balls, const MotionSettings& s, double dt) {
     const FixityMask fix = balls.fixity[i];
     const Vec3 f = unbalanced_force(balls, i, s.gravity);
     const Vec3 mo = unbalanced_moment(balls, i);
-    const double inv_m = 1.0 / balls.mass[i], inv_i = 1.0 / balls.inertia[i];
+    const double inv_m = 1.0 / (inertial_mass ? inertial_mass[i] : balls.mass[i]);
+    const double inv_i = 1.0 / (inertial_inertia ? inertial_inertia[i] : balls.inertia[i]);
     Vec3& v = balls.velocity[i];
     Vec3& w = balls.spin[i];
     for (int d = 0; d < 3; ++d) {

@@ -23,6 +23,9 @@ inline Vec3 unbalanced_moment(const BallStore& b, std::size_t i) {
 }
 
 // Advance velocities from t−Δt/2 to t+Δt/2 with the forces at t, then positions to t+Δt.
-void advance_balls(BallStore& balls, const MotionSettings& s, double dt);
+// With density scaling, inertial_mass/inertial_inertia replace m and I in the accelerations only
+// (gravity keeps the real mass).
+void advance_balls(BallStore& balls, const MotionSettings& s, double dt, const double* inertial_mass = nullptr,
+                   const double* inertial_inertia = nullptr);
 
 }  // namespace hilldem
