@@ -10,24 +10,32 @@ namespace hilldem::cli {
 
 Command add_bench_command(CLI::App& app) {
   auto o = std::make_shared<BedBenchOptions>();
+  auto settle_out = std::make_shared<std::string>();
   auto* bench = app.add_subcommand(
       "bench", "Time the dense bed of bench/ (hill model, periodic x-y, floor, gravity, dt 1e-6 s); prints one line");
-  bench->add_option("--data", o->data, "LAMMPS data file of the bed (default bench/pack_base.data)");
+  bench->add_option("--data", o->data, "LAMMPS data file of the bed (default bench/bed_settled.data)");
   bench->add_option("--replicate", o->replicate, "copies in x and y (3: 100,800 spheres)")->check(CLI::Range(1, 20));
   bench->add_option("--steps", o->steps, "timed steps")->check(CLI::Range(1, 100000000));
   bench->add_option("--warmup", o->warmup, "untimed steps first")->check(CLI::Range(0, 100000000));
   bench->add_option("--threads", o->threads, "OpenMP threads (0: default)")->check(CLI::Range(0, 1024));
-  return {bench, [o] {
+  bench->add_option("--settle", *settle_out,
+                    "instead of timing: settle the --data bed under hilldem's laws and write it to this file");
+  return {bench, [o, settle_out] {
             BedBenchOptions opt = *o;
             if (opt.data.empty()) {
-              for (const std::string p : {std::string("bench/pack_base.data"),
-                                          std::string(HILLDEM_SOURCE_DIR) + "/bench/pack_base.data"})
+              for (const std::string p : {std::string("bench/bed_settled.data"),
+                                          std::string(HILLDEM_SOURCE_DIR) + "/bench/bed_settled.data"})
                 if (std::filesystem::exists(p)) {
                   opt.data = p;
                   break;
                 }
               if (opt.data.empty())
                 throw InputError("no bed: pass --data FILE (a LAMMPS data file from bench/lammps/in.pack)");
+            }
+            if (!settle_out->empty()) {
+              const auto steps = settle_bed(opt.data, *settle_out, 1e-3);
+              std::cout << "settled in " << steps << " steps: " << *settle_out << std::endl;
+              return 0;
             }
             std::cout << run_bed_bench(opt).line() << std::endl;
             return 0;

@@ -4,6 +4,8 @@
 #include <fmt/format.h>
 #include <omp.h>
 
+#include "hilldem/core/error.hpp"
+
 namespace hilldem {
 
 std::string BedBenchResult::line() const {
@@ -53,6 +55,21 @@ Simulation make_bed(const Packing& packing) {
   sim.walls.add(floor);
   sim.sort_balls_spatially();
   return sim;
+}
+
+std::int64_t settle_bed(const std::string& in, const std::string& out, double ratio) {
+  Packing packing = read_packing(in, PackingFormat::Lammps);
+  Simulation sim = make_bed(packing);
+  sim.settings.local_damping = 0.7;
+  const std::int64_t steps = sim.solve(ratio, 200000);
+  if (steps < 0) throw RunError("the bed did not settle within 200000 steps");
+  packing.balls.clear();
+  for (std::size_t i = 0; i < sim.balls.size(); ++i)
+    packing.balls.push_back({sim.balls.position[i], sim.balls.radius[i], sim.balls.density[i]});
+  write_lammps_data(out, packing,
+                    fmt::format("hilldem settled bed: {} spheres, local damping 0.7 to ratio {:g} in {} steps",
+                                sim.balls.size(), ratio, steps));
+  return steps;
 }
 
 BedBenchResult run_bed_bench(const BedBenchOptions& o) {

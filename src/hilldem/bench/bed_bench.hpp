@@ -34,4 +34,10 @@ struct BedBenchResult {
 Simulation make_bed(const Packing& packing);
 BedBenchResult run_bed_bench(const BedBenchOptions& options);
 
+// Settle a bed under hilldem's own contact laws (local damping 0.7, to a mean unbalanced-force
+// ratio of `ratio`) and write it as a LAMMPS data file, so that both codes time the same bed.
+// LAMMPS settles with a Hertz floor; hilldem's floor is linear (hill contacts are grain-grain
+// only), so a LAMMPS bed starts with a kick at the floor. Returns the steps used.
+std::int64_t settle_bed(const std::string& in, const std::string& out, double ratio);
+
 }  // namespace hilldem

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <fmt/format.h>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -127,6 +128,25 @@ Packing read_packing(const std::string& path, PackingFormat format) {
   std::ostringstream ss;
   ss << in.rdbuf();
   return parse_packing(ss.str(), path, format);
+}
+
+void write_lammps_data(const std::string& path, const Packing& p, const std::string& title) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw InputError(path + ": cannot write");
+    out << title << "\n\n" << p.balls.size() << " atoms\n1 atom types\n\n";
+    out << fmt::format("{:.17g} {:.17g} xlo xhi\n{:.17g} {:.17g} ylo yhi\n{:.17g} {:.17g} zlo zhi\n\n", p.box_lo.x,
+                       p.box_hi.x, p.box_lo.y, p.box_hi.y, p.box_lo.z, p.box_hi.z);
+    out << "Atoms # sphere\n\n";
+    std::size_t id = 1;
+    for (const ImportedBall& b : p.balls)
+      out << fmt::format("{} 1 {:.17g} {:.17g} {:.17g} {:.17g} {:.17g}\n", id++, 2.0 * b.radius, b.density, b.position.x,
+                         b.position.y, b.position.z);
+    out.flush();
+    if (!out) throw InputError(path + ": write failed");
+  }
+  std::filesystem::rename(tmp, path);
 }
 
 void replicate(Packing& p, const int n[3]) {

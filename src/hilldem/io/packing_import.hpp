@@ -31,4 +31,8 @@ Packing parse_packing(const std::string& text, const std::string& name, PackingF
 // Copies the packing n[0] × n[1] × n[2] times by the box lengths (needs a box).
 void replicate(Packing& p, const int n[3]);
 
+// Write a packing as a LAMMPS data file (atom_style sphere, SI), which LAMMPS and hilldem both read:
+// the benchmark's two codes then start from the very same bed. Atomic (temporary file + rename).
+void write_lammps_data(const std::string& path, const Packing& p, const std::string& title);
+
 }  // namespace hilldem
