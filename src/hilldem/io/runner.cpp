@@ -1,14 +1,25 @@
 #include "hilldem/io/runner.hpp"
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <ctime>
 #include <filesystem>
 #include <fmt/format.h>
 #include <fstream>
+#include <iostream>
+#include <memory>
 #include <ostream>
+#include <unistd.h>
 
 #include "hilldem/core/error.hpp"
+#include "hilldem/io/fault_injection.hpp"
+#include "hilldem/io/state_io.hpp"
+#include "hilldem/io/vtk_writer.hpp"
 
 namespace hilldem {
+
+namespace fs = std::filesystem;
 
 const ProbeValue* RunResult::find(const std::string& label) const {
   for (const ProbeValue& p : probes)
@@ -16,80 +27,111 @@ const ProbeValue* RunResult::find(const std::string& label) const {
   return nullptr;
 }
 
+namespace {
+
+const char* moisture_text(const ContactStore& c, std::size_t k) {
+  return c.model[k] == ModelKind::Linear ? "-"
+         : c.moisture[k] == Moisture::Wet ? "wet"
+         : c.moisture[k] == Moisture::Ruptured ? "rupt"
+                                               : "dry";
+}
+
+std::string pieces_text(const Simulation& sim, std::size_t k) {
+  const ContactKey& key = sim.contacts.key[k];
+  return key.kind == ContactKind::BallBall
+             ? fmt::format("ball {} - ball {}", sim.balls.id[key.a], sim.balls.id[key.b])
+             : fmt::format("ball {} - wall {}", sim.balls.id[key.a], sim.walls.walls[key.b].name);
+}
+
+}  // namespace
+
 std::string contact_listing(const Simulation& sim) {
   std::string out = fmt::format("{:<24} {:<7} {:>12} {:>12} {:<5} {}\n", "pieces", "model", "gap[m]",
                                 "normal[N]", "state", "assigned by");
   const ContactStore& c = sim.contacts;
   for (std::size_t k = 0; k < c.size(); ++k) {
     if (!c.exists[k]) continue;
-    const ContactKey& key = c.key[k];
-    const std::string pieces =
-        key.kind == ContactKind::BallBall
-            ? fmt::format("ball {} - ball {}", sim.balls.id[key.a], sim.balls.id[key.b])
-            : fmt::format("ball {} - wall {}", sim.balls.id[key.a], sim.walls.walls[key.b].name);
-    const char* state = c.model[k] == ModelKind::Linear ? "-"
-                        : c.moisture[k] == Moisture::Wet ? "wet"
-                        : c.moisture[k] == Moisture::Ruptured ? "rupt"
-                                                              : "dry";
-    out += fmt::format("{:<24} {:<7} {:>12.5g} {:>12.5g} {:<5} {}\n", pieces, to_string(c.model[k]), c.gap[k],
-                       c.normal_force[k], state, sim.table.explain(c.rule[k]));
+    out += fmt::format("{:<24} {:<7} {:>12.5g} {:>12.5g} {:<5} {}\n", pieces_text(sim, k), to_string(c.model[k]), c.gap[k],
+                       c.normal_force[k], moisture_text(c, k), sim.table.explain(c.rule[k]));
   }
   out += fmt::format("{} contacts; {} neighbour pairs matched no rule at the last detection\n", sim.contact_count(),
                      sim.unassigned_pairs());
   return out;
 }
 
+std::string probe_table(const RunResult& res) {
+  if (res.probes.empty()) return "";
+  std::string out = fmt::format("{:<12} {:<26} {:<22} {:>16} {}\n", "label", "quantity", "target", "value", "unit");
+  for (const auto& p : res.probes)
+    out += fmt::format("{:<12} {:<26} {:<22} {:>16.8g} {}\n", p.label, p.quantity, p.target, p.value, p.unit);
+  return out;
+}
+
+double evaluate(const Scenario& sc, const Quantity& q, int servo) {
+  if (servo < 0) return evaluate(sc.sim, q);
+  const Servo& s = sc.servos[static_cast<std::size_t>(servo)].servo;
+  if (q.field == "stress") return s.stress(sc.sim);
+  if (q.field == "target_stress") return s.settings.target_stress;
+  if (q.field == "speed") return s.speed();
+  return s.enabled ? 1.0 : 0.0;  // "enabled"
+}
+
 namespace {
+
+constexpr const char* kCheckpointFolder = "checkpoints";
+constexpr const char* kMetaSection = "run.meta";
+
+// ---- history CSV ----
 
 class HistoryWriter {
  public:
-  HistoryWriter(const Scenario& sc, const std::string& path) : sc_(sc), out_(path) {
-    if (!out_) throw InputError(path + ": cannot write the history file");
-    out_ << "step,time[s]";
-    for (const History& h : sc.histories) out_ << "," << h.name << "[" << h.quantity.unit << "]";
-    out_ << "\n";
+  // A new file with its header line.
+  HistoryWriter(const Scenario& sc, const std::string& path) : sc_(sc), path_(path) { open_fresh(); }
+  // Continue a file a checkpoint recorded at `bytes` bytes: rows written after that checkpoint are
+  // cut off (the resumed run writes them again). A missing or shorter file starts afresh (reported).
+  HistoryWriter(const Scenario& sc, const std::string& path, std::uint64_t bytes, std::ostream& log) : sc_(sc), path_(path) {
+    std::error_code ec;
+    const auto size = fs::file_size(path, ec);
+    if (ec || size < bytes) {
+      log << fmt::format("warning: {} is {} than the checkpoint recorded ({} bytes); it restarts here\n", path,
+                         ec ? "missing, not longer" : "shorter", bytes);
+      open_fresh();
+      return;
+    }
+    fs::resize_file(path, bytes, ec);
+    if (ec) throw InputError(path + ": cannot cut the history back to the checkpoint: " + ec.message());
+    out_.open(path, std::ios::binary | std::ios::app);
+    if (!out_) throw InputError(path + ": cannot append to the history file");
   }
   void sample(const Simulation& sim) {
     out_ << sim.steps << "," << fmt::format("{:.9e}", sim.time);
     for (const History& h : sc_.histories) {
-      const double v = evaluate(sim, h.quantity);
+      const double v = evaluate(sc_, h.quantity, h.servo);
       out_ << ",";
       if (std::isfinite(v)) out_ << fmt::format("{:.9e}", v);
     }
     out_ << "\n";
   }
-  void flush() { out_.flush(); }
+  // Flush and return the file's length [bytes].
+  std::uint64_t flush() {
+    out_.flush();
+    if (!out_) throw RunError(path_ + ": writing the history failed");
+    return static_cast<std::uint64_t>(out_.tellp());
+  }
+  const std::string& path() const { return path_; }
 
  private:
+  void open_fresh() {
+    out_.open(path_, std::ios::binary | std::ios::trunc);
+    if (!out_) throw InputError(path_ + ": cannot write the history file");
+    out_ << "step,time[s]";
+    for (const History& h : sc_.histories) out_ << "," << h.name << "[" << h.quantity.unit << "]";
+    out_ << "\n";
+  }
   const Scenario& sc_;
+  std::string path_;
   std::ofstream out_;
 };
-
-// Translate (by [m]) or rotate (by [rad], rotation vector) the selected balls over `steps` cycles
-// with imposed velocities, so that the contacts see the motion increment by increment. The balls are
-// fixed in the moved components during the stage, then left at rest with their former fixity.
-void impose_motion(Simulation& sim, const Stage& s) {
-  const bool spin = s.type == StageType::Rotate;
-  const FixityMask mask = spin ? kFixSpin : kFixVel;
-  std::vector<FixityMask> saved;
-  for (std::size_t i : s.sel.balls) {
-    saved.push_back(sim.balls.fixity[i]);
-    sim.balls.fixity[i] |= mask;
-  }
-  Vec3 done;
-  for (std::int64_t k = 0; k < s.steps; ++k) {
-    const double dt = sim.next_timestep();
-    const Vec3 rate = (s.by - done) / (static_cast<double>(s.steps - k) * dt);
-    for (std::size_t i : s.sel.balls) (spin ? sim.balls.spin[i] : sim.balls.velocity[i]) = rate;
-    sim.cycle(1);
-    done += rate * sim.last_dt;
-  }
-  for (std::size_t n = 0; n < s.sel.balls.size(); ++n) {
-    const std::size_t i = s.sel.balls[n];
-    (spin ? sim.balls.spin[i] : sim.balls.velocity[i]) = Vec3{};
-    sim.balls.fixity[i] = saved[n];
-  }
-}
 
 void apply_set(Simulation& sim, const Stage& s) {
   for (std::size_t k : s.sel.walls) {
@@ -112,9 +154,11 @@ void apply_set(Simulation& sim, const Stage& s) {
 }
 
 void apply_set_contacts(Simulation& sim, const Stage& s) {
+  // Existing contacts only (docs/scenario-format.md): a neighbour pair that becomes a contact later
+  // takes its properties from the assignment table, whenever the neighbour list happened to be built.
   ContactStore& c = sim.contacts;
   for (std::size_t k = 0; k < c.size(); ++k) {
-    if (c.model[k] != *s.model_filter) continue;
+    if (!c.exists[k] || c.model[k] != *s.model_filter) continue;
     if (c.model[k] == ModelKind::Hill) {
       HillParams& p = c.hill_params[k];
       if (s.fric) p.fric_coef = *s.fric;
@@ -130,82 +174,654 @@ void apply_set_contacts(Simulation& sim, const Stage& s) {
   sim.refresh_mappings();  // β_n, β_s depend on γ_h; k_n on E* (spec §2.4)
 }
 
+void apply_set_servo(Scenario& sc, const Stage& s) {
+  Servo& servo = sc.servos[static_cast<std::size_t>(s.servo)].servo;
+  if (s.target_stress) servo.settings.target_stress = *s.target_stress;
+  if (s.gain_factor) servo.settings.gain_factor = *s.gain_factor;
+  if (s.max_speed) servo.settings.max_speed = *s.max_speed;
+  if (s.enabled) servo.enabled = *s.enabled;
+}
+
+// Stages after which the state may differ from before (snapshots and checkpoints at stage ends).
+bool changes_state(StageType t) { return t != StageType::Probe && t != StageType::ListContacts; }
+
+// Where the runner is: the stage, and its progress inside it.
+struct Position {
+  std::uint64_t stage = 0;          // index of the stage running (or next to run)
+  std::int64_t stage_steps = 0;     // cycles done inside it
+  bool started = false;             // translate/rotate: fixity saved and the motion begun
+  Vec3 motion_done;                 // translate [m] / rotate [rad] imposed so far
+  std::vector<FixityMask> saved_fixity;  // translate/rotate: the fixity to restore at the end
+};
+
+struct Halted {};  // RunOptions::halt_after_step reached
+
+std::string stage_head(const Scenario& sc, std::size_t k) {
+  const Stage& s = sc.stages[k];
+  return fmt::format("[{}/{}] {} '{}'", k + 1, sc.stages.size(), to_string(s.type), s.name);
+}
+
+double now_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+bool finite3(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+std::string vec_text(const Vec3& v) { return fmt::format("[{:.6g}, {:.6g}, {:.6g}]", v.x, v.y, v.z); }
+
+// Every contact of ball index i, one line each.
+std::string ball_contacts_text(const Simulation& sim, std::size_t i, std::size_t limit = 50) {
+  const ContactStore& c = sim.contacts;
+  std::string out;
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < c.size(); ++k) {
+    if (!c.exists[k]) continue;
+    const ContactKey& key = c.key[k];
+    if (key.a != i && !(key.kind == ContactKind::BallBall && key.b == i)) continue;
+    if (n++ == limit) {
+      out += "    ...\n";
+      break;
+    }
+    out += fmt::format("    {:<26} {:<6} {:<4} {:<6} gap {:>12.5g} m  normal {:>12.5g} N  shear {:>12.5g} N  moisture {:>12.5g} N\n",
+                       pieces_text(sim, k), to_string(c.model[k]), moisture_text(c, k), c.active[k] ? "active" : "open",
+                       c.gap[k], c.normal_force[k], norm(c.shear_force[k]), c.moisture_force[k]);
+  }
+  return n == 0 ? "    (no contacts)\n" : out;
+}
+
+class Runner {
+ public:
+  Runner(Scenario& sc, const RunOptions& options, std::ostream& log)
+      : sc_(sc), sim_(sc.sim), opt_(options), log_(log),
+        progress_(options.progress_stream ? *options.progress_stream : std::cerr,
+                  options.quiet ? ProgressMode::Off : options.progress,
+                  !options.progress_stream && ::isatty(STDERR_FILENO) == 1, options.progress_interval) {}
+
+  ~Runner() {
+    sim_.observers.clear();
+    sim_.controllers.clear();
+  }
+
+  // Fresh run from the first stage.
+  RunResult run(const std::string& dir) {
+    open_outputs(dir, nullptr);
+    sim_.update_forces();
+    if (history_) history_->sample(sim_);
+    if (snapshots_) snapshots_->write(sim_);
+    return run_stages();
+  }
+
+  // Continue from a checkpoint whose sim.* sections are already restored into the scenario.
+  RunResult resume(const CheckpointReader& r, const std::string& dir) {
+    read_position(r);
+    last_checkpoint_stage_ = pos_.stage;  // the checkpoint resumed from is at this position
+    open_outputs(dir, &r);
+    return run_stages();
+  }
+
+  void read_position(const CheckpointReader& r) {
+    {
+      SectionReader s = r.section("run.position");
+      pos_.stage = s.u64();
+      pos_.stage_steps = s.i64();
+      pos_.started = s.boolean();
+      pos_.motion_done = s.vec3();
+      s.column(pos_.saved_fixity, "saved_fixity");
+      const std::uint64_t n = s.count(8 * 5 + 8, 1'000'000);
+      for (std::uint64_t k = 0; k < n; ++k) {
+        ProbeValue p;
+        p.label = s.str(4096);
+        p.quantity = s.str(4096);
+        p.target = s.str(4096);
+        p.unit = s.str(4096);
+        p.value = s.f64();
+        result_.probes.push_back(p);
+      }
+      s.finish();
+      if (pos_.stage > sc_.stages.size())
+        s.fail(fmt::format("stage {} of a scenario with {} stages", pos_.stage + 1, sc_.stages.size()));
+      if (pos_.stage_steps < 0) s.fail("a negative step count inside the stage");
+      if (pos_.stage < sc_.stages.size()) {
+        const Stage& st = sc_.stages[pos_.stage];
+        const bool motion = st.type == StageType::Translate || st.type == StageType::Rotate;
+        const bool cycling = motion || st.type == StageType::Cycle || st.type == StageType::Solve;
+        if (!cycling && pos_.stage_steps != 0) s.fail("steps inside a stage that does not cycle");
+        if ((st.type == StageType::Cycle || motion) && pos_.stage_steps > st.steps)
+          s.fail(fmt::format("{} steps done inside a stage of {}", pos_.stage_steps, st.steps));
+        if (motion && pos_.started && pos_.saved_fixity.size() != st.sel.balls.size())
+          s.fail("the saved fixities do not match the stage's selection");
+        if (!finite3(pos_.motion_done)) s.fail("the imposed motion so far is not finite");
+      }
+    }
+    {
+      SectionReader s = r.section("run.servos");
+      const std::uint64_t n = s.count(8, 1'000'000);
+      if (n != sc_.servos.size())
+        s.fail(fmt::format("{} servos; the scenario defines {}", n, sc_.servos.size()));
+      for (ScenarioServo& sv : sc_.servos) {
+        const std::string name = s.str(4096);
+        if (name != sv.name) s.fail("servo '" + name + "' is not the scenario's servo '" + sv.name + "'");
+        sv.servo.settings.target_stress = s.f64();
+        sv.servo.settings.gain_factor = s.f64();
+        sv.servo.settings.max_speed = s.f64();
+        sv.servo.enabled = s.boolean();
+        s.f64();  // the speed it last imposed (informational: recomputed at the start of every cycle)
+        if (!std::isfinite(sv.servo.settings.target_stress) || !(sv.servo.settings.gain_factor > 0.0) ||
+            !(sv.servo.settings.gain_factor <= 1.0) || !(sv.servo.settings.max_speed > 0.0))
+          s.fail("servo '" + name + "' has settings out of range");
+      }
+      s.finish();
+    }
+  }
+
+ private:
+  // ---- outputs ----
+
+  void open_outputs(const std::string& dir, const CheckpointReader* resume) {
+    for (ScenarioServo& s : sc_.servos)
+      sim_.controllers.push_back([servo = &s.servo](Simulation& sim, double dt) { servo->control(sim, dt); });
+    if (!opt_.write_files || dir.empty()) return;
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec) throw InputError(dir + ": cannot create the output folder: " + ec.message());
+    dir_ = dir;
+
+    std::uint64_t history_bytes = 0;
+    std::vector<SnapshotEntry> entries;
+    bool had_history = false;
+    if (resume) {
+      SectionReader s = resume->section("run.outputs");
+      had_history = s.boolean();
+      history_bytes = s.u64();
+      const std::uint64_t n = s.count(24, 100'000'000);
+      for (std::uint64_t k = 0; k < n; ++k) {
+        SnapshotEntry e;
+        e.index = s.i64();
+        e.step = s.i64();
+        e.time = s.f64();
+        if (e.index < 0 || e.step < 0) s.fail("a snapshot entry with a negative index or step");
+        entries.push_back(e);
+      }
+      seq_ = s.u64();
+      s.finish();
+    }
+    if (!sc_.histories.empty()) {
+      result_.history_path = (fs::path(dir) / sc_.history_file).string();
+      history_ = resume && had_history ? std::make_unique<HistoryWriter>(sc_, result_.history_path, history_bytes, log_)
+                                       : std::make_unique<HistoryWriter>(sc_, result_.history_path);
+      const std::int64_t every = sc_.history_every;
+      sim_.observers.push_back([h = history_.get(), every](const Simulation& s) {
+        if (s.steps % every == 0) h->sample(s);
+      });
+    }
+    if (sc_.snapshots.enabled) {
+      result_.snapshot_dir = (fs::path(dir) / sc_.snapshots.folder).string();
+      snapshots_ = std::make_unique<SnapshotSeries>(
+          result_.snapshot_dir, SnapshotOptions{sc_.snapshots.contacts, sc_.snapshots.walls, sc_.snapshots.binary});
+      if (resume) snapshots_->restore(std::move(entries));
+    }
+    if (sc_.checkpoints.enabled) {
+      result_.checkpoint_dir = (fs::path(dir) / kCheckpointFolder).string();
+      fs::create_directories(result_.checkpoint_dir, ec);
+      if (ec) throw InputError(result_.checkpoint_dir + ": cannot create the checkpoint folder: " + ec.message());
+      // Checkpoints newer than the one resumed from belong to the lost part of the run: remove them.
+      for (const auto& e : fs::directory_iterator(result_.checkpoint_dir, ec)) {
+        unsigned long long n = 0;
+        const std::string name = e.path().filename().string();
+        if (std::sscanf(name.c_str(), "ckpt-%llu.hdc", &n) == 1 && name == fmt::format("ckpt-{:06}.hdc", n) && n > seq_)
+          fs::remove(e.path(), ec);
+        if (name.find(".tmp.") != std::string::npos) fs::remove(e.path(), ec);  // torn writes of a killed run
+      }
+      last_checkpoint_time_ = now_seconds();
+    }
+  }
+
+  std::uint64_t flush_history() { return history_ ? history_->flush() : 0; }
+
+  void write_run_sections(CheckpointWriter& w, const std::string& kind, const std::string& message) {
+    {
+      SectionWriter& s = w.section(kMetaSection);
+      s.str(kind);
+      s.str(message);
+      s.i64(static_cast<std::int64_t>(std::time(nullptr)));
+      s.str(state_digest(sim_));
+    }
+    {
+      SectionWriter& s = w.section("run.scenario");
+      s.str(sc_.file);
+      s.str(sc_.text);
+    }
+    {
+      SectionWriter& s = w.section("run.position");
+      s.u64(pos_.stage);
+      s.i64(pos_.stage_steps);
+      s.boolean(pos_.started);
+      s.vec3(pos_.motion_done);
+      s.column(pos_.saved_fixity);
+      s.u64(result_.probes.size());
+      for (const ProbeValue& p : result_.probes) {
+        s.str(p.label);
+        s.str(p.quantity);
+        s.str(p.target);
+        s.str(p.unit);
+        s.f64(p.value);
+      }
+    }
+    {
+      SectionWriter& s = w.section("run.outputs");
+      s.boolean(history_ != nullptr);
+      s.u64(flush_history());
+      const std::vector<SnapshotEntry> none;
+      const auto& entries = snapshots_ ? snapshots_->entries() : none;
+      s.u64(entries.size());
+      for (const SnapshotEntry& e : entries) {
+        s.i64(e.index);
+        s.i64(e.step);
+        s.f64(e.time);
+      }
+      s.u64(seq_);
+    }
+    {
+      SectionWriter& s = w.section("run.servos");
+      s.u64(sc_.servos.size());
+      for (const ScenarioServo& sv : sc_.servos) {
+        s.str(sv.name);
+        s.f64(sv.servo.settings.target_stress);
+        s.f64(sv.servo.settings.gain_factor);
+        s.f64(sv.servo.settings.max_speed);
+        s.boolean(sv.servo.enabled);
+        s.f64(sv.servo.speed());
+      }
+    }
+    write_simulation(w, sim_);
+  }
+
+  void checkpoint(const char* kind) {
+    if (result_.checkpoint_dir.empty()) return;
+    ++seq_;
+    const std::string path = (fs::path(result_.checkpoint_dir) / fmt::format("ckpt-{:06}.hdc", seq_)).string();
+    CheckpointWriter w;
+    write_run_sections(w, kind, "");
+    w.write_file(path);
+    result_.last_checkpoint = path;
+    last_checkpoint_stage_ = pos_.stage;
+    last_checkpoint_time_ = now_seconds();
+    // Keep the newest `keep`.
+    if (seq_ > static_cast<std::uint64_t>(sc_.checkpoints.keep)) {
+      std::error_code ec;
+      for (std::uint64_t old = seq_ - static_cast<std::uint64_t>(sc_.checkpoints.keep); old > 0; --old) {
+        const fs::path p = fs::path(result_.checkpoint_dir) / fmt::format("ckpt-{:06}.hdc", old);
+        if (!fs::remove(p, ec)) break;
+      }
+    }
+  }
+
+  // The state after a blow-up, for inspection (hilldem inspect). Returns a sentence for the error.
+  std::string dump_blowup(const std::string& message) {
+    if (!opt_.write_files) return "no state file written (file output is off)";
+    const std::string folder = dir_.empty() ? "." : dir_;
+    const std::string path = (fs::path(folder) / fmt::format("blowup-step-{}.hdc", sim_.steps)).string();
+    try {
+      CheckpointWriter w;
+      write_run_sections(w, "blow-up", message);
+      w.write_file(path);
+    } catch (const std::exception& e) {
+      return std::string("the state could not be written: ") + e.what();
+    }
+    return "state written to " + path + " (hilldem inspect " + path + " --ball ID)";
+  }
+
+  // ---- cycling ----
+
+  void cycle_once() {
+    try {
+      sim_.cycle(1);
+    } catch (const RunError& e) {
+      progress_.clear();
+      const std::string what = e.what();
+      throw RunError(what + "\n  " + dump_blowup(what));
+    }
+  }
+
+  // A free ball moving more than blowup_fraction × its radius in one step, or anything non-finite.
+  void check_blowup() {
+    const double f = sc_.blowup_fraction;
+    const BallStore& b = sim_.balls;
+    const double dt = sim_.last_dt;
+    const std::size_t n = b.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec3& v = b.velocity[i];
+      const double move2 = norm2(v) * dt * dt;
+      const bool finite = std::isfinite(move2) && finite3(b.position[i]) && finite3(b.spin[i]);
+      const bool free = (b.fixity[i] & kFixVel) != kFixVel;
+      if (finite && !(f > 0.0 && free && move2 > f * f * b.radius[i] * b.radius[i])) continue;
+      std::string why = finite ? fmt::format("ball {} moved {:.4g} m in one step ({:.3g} of its radius {:.4g} m; the limit, "
+                                             "[simulation] blowup_fraction, is {:g})",
+                                             b.id[i], std::sqrt(move2), std::sqrt(move2) / b.radius[i], b.radius[i], f)
+                               : fmt::format("ball {} has a non-finite position, velocity or spin", b.id[i]);
+      blowup(why + fmt::format("\n  position {} m, velocity {} m/s, spin {} rad/s, contact force {} N\n  its contacts:\n",
+                               vec_text(b.position[i]), vec_text(v), vec_text(b.spin[i]), vec_text(b.contact_force[i])) +
+             ball_contacts_text(sim_, i));
+    }
+    for (const Wall& w : sim_.walls.walls)
+      if (!finite3(w.velocity) || !finite3(w.force) || !finite3(w.point) || !std::isfinite(w.radius))
+        blowup(fmt::format("wall '{}' has a non-finite position, velocity or force (velocity {} m/s, force {} N)", w.name,
+                           vec_text(w.velocity), vec_text(w.force)));
+  }
+
+  [[noreturn]] void blowup(const std::string& what) {
+    progress_.clear();
+    const std::string message = fmt::format("blow-up at step {} (t = {:.6g} s, dt = {:.4g} s, in {}): {}", sim_.steps,
+                                            sim_.time, sim_.last_dt,
+                                            pos_.stage < sc_.stages.size() ? stage_head(sc_, pos_.stage) : "no stage", what);
+    throw RunError(message + "  " + dump_blowup(message));
+  }
+
+  // After every cycle: checks, periodic outputs (unless the stage ends with this cycle), progress,
+  // fault injection and the test halt.
+  void after_cycle(bool stage_ends, double ratio = -1.0) {
+    check_blowup();
+    if (!stage_ends) {
+      if (snapshots_ && sc_.snapshots.every > 0 && sim_.steps % sc_.snapshots.every == 0) snapshots_->write(sim_);
+      const CheckpointSettings& c = sc_.checkpoints;
+      if (!result_.checkpoint_dir.empty()) {
+        if (c.every > 0 && sim_.steps % c.every == 0) checkpoint("periodic (steps)");
+        else if (c.every_seconds > 0.0 && now_seconds() - last_checkpoint_time_ >= c.every_seconds) checkpoint("periodic (time)");
+      }
+      progress_.tick(sim_, pos_.stage_steps, ratio);
+    }
+    fault_injection().on_step(sim_.steps);
+    if (opt_.halt_after_step >= 0 && sim_.steps >= opt_.halt_after_step) throw Halted{};
+  }
+
+  void run_motion(const Stage& s) {
+    const bool spin = s.type == StageType::Rotate;
+    const FixityMask mask = spin ? kFixSpin : kFixVel;
+    if (!pos_.started) {
+      pos_.saved_fixity.clear();
+      for (std::size_t i : s.sel.balls) {
+        pos_.saved_fixity.push_back(sim_.balls.fixity[i]);
+        sim_.balls.fixity[i] |= mask;
+      }
+      pos_.motion_done = Vec3{};
+      pos_.started = true;
+    }
+    // Imposed velocities, so that the contacts see the motion step by step; the rate is re-aimed at
+    // what is left each step (the time step may change).
+    while (pos_.stage_steps < s.steps) {
+      const double dt = sim_.next_timestep();
+      const Vec3 rate = (s.by - pos_.motion_done) / (static_cast<double>(s.steps - pos_.stage_steps) * dt);
+      for (std::size_t i : s.sel.balls) (spin ? sim_.balls.spin[i] : sim_.balls.velocity[i]) = rate;
+      cycle_once();
+      pos_.motion_done += rate * sim_.last_dt;
+      ++pos_.stage_steps;
+      after_cycle(pos_.stage_steps == s.steps);
+    }
+    // Left at rest with their former fixity.
+    for (std::size_t n = 0; n < s.sel.balls.size(); ++n) {
+      const std::size_t i = s.sel.balls[n];
+      (spin ? sim_.balls.spin[i] : sim_.balls.velocity[i]) = Vec3{};
+      sim_.balls.fixity[i] = pos_.saved_fixity[n];
+    }
+  }
+
+  std::string run_stage(const Stage& s) {
+    switch (s.type) {
+      case StageType::Cycle:
+        while (pos_.stage_steps < s.steps) {
+          cycle_once();
+          ++pos_.stage_steps;
+          after_cycle(pos_.stage_steps == s.steps);
+        }
+        return fmt::format("{} steps", s.steps);
+      case StageType::Solve:
+        // Cycle (at least once) until the mean unbalanced-force ratio is ≤ ratio (Simulation::solve).
+        while (true) {
+          if (pos_.stage_steps >= s.max_steps)
+            throw RunError(fmt::format("{}: no equilibrium within max_steps = {} (mean unbalanced-force ratio {:.3g} > {:.3g})",
+                                       stage_head(sc_, pos_.stage), s.max_steps, sim_.mean_unbalanced_ratio(), s.ratio));
+          cycle_once();
+          ++pos_.stage_steps;
+          const double r = sim_.mean_unbalanced_ratio();
+          const bool done = r <= s.ratio;
+          after_cycle(done, r);
+          if (done) break;
+        }
+        return fmt::format("equilibrium after {} steps (ratio {:.3g})", pos_.stage_steps, sim_.mean_unbalanced_ratio());
+      case StageType::Translate:
+      case StageType::Rotate:
+        run_motion(s);
+        return fmt::format("{} by [{:g}, {:g}, {:g}] {} in {} steps", s.sel.text, s.by.x, s.by.y, s.by.z,
+                           s.type == StageType::Rotate ? "rad" : "m", s.steps);
+      case StageType::Set: apply_set(sim_, s); return s.sel.text;
+      case StageType::SetContacts: apply_set_contacts(sim_, s); return "";
+      case StageType::SetSimulation:
+        if (s.gravity) sim_.settings.gravity = *s.gravity;
+        if (s.local_damping) sim_.settings.local_damping = *s.local_damping;
+        if (s.timestep) {
+          sim_.settings.auto_timestep = *s.timestep == 0.0;
+          if (*s.timestep > 0.0) sim_.settings.timestep = *s.timestep;
+        }
+        return "";
+      case StageType::MakeWet: return fmt::format("{} wet hill contacts", sim_.make_wet(s.wet_suction, s.wet_gap));
+      case StageType::MakeDry: return fmt::format("{} contacts dried", sim_.make_dry());
+      case StageType::Probe: {
+        double v = evaluate(sc_, s.quantity, s.servo);
+        if (!s.ratio_to.empty()) v /= result_.find(s.ratio_to)->value;
+        v *= s.scale;
+        result_.probes.push_back({s.label, s.quantity.name, s.quantity.target_text,
+                                  s.ratio_to.empty() ? s.quantity.unit : "-", v});
+        return fmt::format("{} = {:.6g} {}", s.label, v, result_.probes.back().unit);
+      }
+      case StageType::ListContacts:
+        if (!opt_.quiet) log_ << contact_listing(sim_);
+        return "";
+      case StageType::SetServo: {
+        apply_set_servo(sc_, s);
+        const ScenarioServo& sv = sc_.servos[static_cast<std::size_t>(s.servo)];
+        return fmt::format("servo {}: target {:g} Pa, {}", sv.name, sv.servo.settings.target_stress,
+                           sv.servo.enabled ? "on" : "off");
+      }
+    }
+    return "";
+  }
+
+  RunResult run_stages() {
+    try {
+      const std::size_t n = sc_.stages.size();
+      if (pos_.stage >= n) result_.already_complete = true;
+      while (pos_.stage < n) {
+        const std::size_t k = pos_.stage;
+        const Stage& s = sc_.stages[k];
+        ProgressStage ps{k + 1, n, to_string(s.type), s.name, -1, 0.0, 0};
+        if (s.type == StageType::Cycle || s.type == StageType::Translate || s.type == StageType::Rotate) ps.total_steps = s.steps;
+        if (s.type == StageType::Solve) ps.target_ratio = s.ratio, ps.max_steps = s.max_steps;
+        progress_.begin_stage(ps, pos_.stage_steps);
+        const std::string what = run_stage(s);
+        progress_.clear();
+        if (!opt_.quiet)
+          log_ << fmt::format("{} {}  (step {}, t = {:.6g} s, {} contacts)\n", stage_head(sc_, k), what, sim_.steps,
+                              sim_.time, sim_.contact_count());
+        pos_ = Position{};
+        pos_.stage = k + 1;
+        if (changes_state(s.type)) {
+          if (snapshots_ && sc_.snapshots.at_stage_ends) snapshots_->write(sim_, true);
+          if (sc_.checkpoints.at_stage_ends) checkpoint("stage end");
+        }
+      }
+      if (!result_.checkpoint_dir.empty() && last_checkpoint_stage_ != n) checkpoint("final");
+      flush_history();
+    } catch (const Halted&) {
+      progress_.clear();
+      result_.halted = true;
+    }
+    return result_;
+  }
+
+  Scenario& sc_;
+  Simulation& sim_;
+  RunOptions opt_;
+  std::ostream& log_;
+  Progress progress_;
+  RunResult result_;
+  Position pos_;
+  std::string dir_;
+  std::unique_ptr<HistoryWriter> history_;
+  std::unique_ptr<SnapshotSeries> snapshots_;
+  std::uint64_t seq_ = 0;
+  std::uint64_t last_checkpoint_stage_ = UINT64_MAX;
+  double last_checkpoint_time_ = 0.0;
+};
+
+// The scenario a checkpoint carries, and its state restored into it.
+void restore_scenario(const CheckpointReader& r, Scenario& sc) {
+  SectionReader s = r.section("run.scenario");
+  const std::string file = s.str(1u << 20);
+  const std::string text = s.str();
+  s.finish();
+  try {
+    sc = load_scenario(text, file);
+  } catch (const InputError& e) {
+    throw InputError(r.source() + ": the scenario it carries does not load: " + e.what());
+  }
+  Simulation restored;
+  read_simulation(r, restored, true);
+  // The stages refer to balls and walls by index and to groups by bit: they must be the scenario's.
+  const Simulation& fresh = sc.sim;
+  auto mismatch = [&](const std::string& what) {
+    throw InputError(r.source() + ": the saved state does not match its scenario (" + what + ")");
+  };
+  if (restored.balls.size() != fresh.balls.size())
+    mismatch(fmt::format("{} balls saved, the scenario has {}", restored.balls.size(), fresh.balls.size()));
+  for (std::size_t i = 0; i < fresh.balls.size(); ++i)
+    if (restored.balls.id[i] != fresh.balls.id[i]) mismatch(fmt::format("ball {} is saved at index {}", restored.balls.id[i], i));
+  if (restored.walls.size() != fresh.walls.size())
+    mismatch(fmt::format("{} walls saved, the scenario has {}", restored.walls.size(), fresh.walls.size()));
+  for (std::size_t w = 0; w < fresh.walls.size(); ++w)
+    if (restored.walls.walls[w].name != fresh.walls.walls[w].name) mismatch("wall '" + restored.walls.walls[w].name + "'");
+  for (int k = 0; k < 64; ++k) {
+    const std::uint64_t bit = std::uint64_t{1} << k;
+    if (fresh.groups.describe(bit) != restored.groups.describe(bit)) mismatch("group names");
+  }
+  if (restored.table.rules.size() != fresh.table.rules.size()) mismatch("assignment rules");
+  sc.sim = std::move(restored);
+  // The restore must give back exactly the state that was saved.
+  SectionReader meta = r.section(kMetaSection);
+  meta.str(4096);
+  meta.str();
+  meta.i64();
+  const std::string digest = meta.str(64);
+  if (state_digest(sc.sim) != digest)
+    throw InputError(r.source() + ": the restored state's digest " + state_digest(sc.sim) + " differs from the saved " + digest);
+}
+
 }  // namespace
 
 RunResult run_scenario(Scenario& sc, const RunOptions& options, std::ostream& log) {
-  Simulation& sim = sc.sim;
-  RunResult result;
   const std::string dir = options.output_dir.empty() ? sc.output_dir : options.output_dir;
-  std::unique_ptr<HistoryWriter> history;
-  if (options.write_files && !dir.empty() && !sc.histories.empty()) {
-    std::error_code ec;
-    std::filesystem::create_directories(dir, ec);
-    if (ec) throw InputError(dir + ": cannot create the output folder: " + ec.message());
-    result.history_path = (std::filesystem::path(dir) / sc.history_file).string();
-    history = std::make_unique<HistoryWriter>(sc, result.history_path);
-    const std::int64_t every = sc.history_every;
-    sim.observers.push_back([h = history.get(), every](const Simulation& s) {
-      if (s.steps % every == 0) h->sample(s);
-    });
-  }
-  sim.update_forces();
-  if (history) history->sample(sim);
+  Runner runner(sc, options, log);
+  return runner.run(dir);
+}
 
-  const std::size_t n = sc.stages.size();
-  for (std::size_t k = 0; k < n; ++k) {
-    const Stage& s = sc.stages[k];
-    const std::string head = fmt::format("[{}/{}] {} '{}'", k + 1, n, to_string(s.type), s.name);
-    std::string what;
-    switch (s.type) {
-      case StageType::Cycle: sim.cycle(s.steps); what = fmt::format("{} steps", s.steps); break;
-      case StageType::Solve: {
-        const std::int64_t used = sim.solve(s.ratio, s.max_steps);
-        if (used < 0)
-          throw RunError(fmt::format("{}: no equilibrium within max_steps = {} (mean unbalanced-force ratio {:.3g} > {:.3g})",
-                                     head, s.max_steps, sim.mean_unbalanced_ratio(), s.ratio));
-        what = fmt::format("equilibrium after {} steps (ratio {:.3g})", used, sim.mean_unbalanced_ratio());
-        break;
-      }
-      case StageType::Translate:
-      case StageType::Rotate:
-        impose_motion(sim, s);
-        what = fmt::format("{} by [{:g}, {:g}, {:g}] {} in {} steps", s.sel.text, s.by.x, s.by.y, s.by.z,
-                           s.type == StageType::Rotate ? "rad" : "m", s.steps);
-        break;
-      case StageType::Set: apply_set(sim, s); what = s.sel.text; break;
-      case StageType::SetContacts: apply_set_contacts(sim, s); break;
-      case StageType::SetSimulation:
-        if (s.gravity) sim.settings.gravity = *s.gravity;
-        if (s.local_damping) sim.settings.local_damping = *s.local_damping;
-        if (s.timestep) {
-          sim.settings.auto_timestep = *s.timestep == 0.0;
-          if (*s.timestep > 0.0) sim.settings.timestep = *s.timestep;
-        }
-        break;
-      case StageType::MakeWet:
-        what = fmt::format("{} wet hill contacts", sim.make_wet(s.wet_suction, s.wet_gap));
-        break;
-      case StageType::MakeDry: what = fmt::format("{} contacts dried", sim.make_dry()); break;
-      case StageType::Probe: {
-        double v = evaluate(sim, s.quantity);
-        if (!s.ratio_to.empty()) v /= result.find(s.ratio_to)->value;
-        v *= s.scale;
-        result.probes.push_back({s.label, s.quantity.name, s.quantity.target_text,
-                                 s.ratio_to.empty() ? s.quantity.unit : "-", v});
-        what = fmt::format("{} = {:.6g} {}", s.label, v, result.probes.back().unit);
-        break;
-      }
-      case StageType::ListContacts:
-        if (!options.quiet) log << contact_listing(sim);
-        break;
-    }
-    if (!options.quiet)
-      log << fmt::format("{} {}  (step {}, t = {:.6g} s, {} contacts)\n", head, what, sim.steps, sim.time,
-                         sim.contact_count());
+std::string find_checkpoint(const std::string& path, std::ostream& log) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw InputError(path + ": no such file or folder");
+  if (!fs::is_directory(path, ec)) return path;
+  fs::path dir(path);
+  if (fs::is_directory(dir / kCheckpointFolder, ec)) dir /= kCheckpointFolder;
+  std::vector<std::pair<unsigned long long, fs::path>> found;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    unsigned long long n = 0;
+    const std::string name = e.path().filename().string();
+    if (std::sscanf(name.c_str(), "ckpt-%llu.hdc", &n) == 1 && name == fmt::format("ckpt-{:06}.hdc", n))
+      found.push_back({n, e.path()});
   }
-  if (history) history->flush();
-  sim.observers.clear();
-  return result;
+  if (ec) throw InputError(dir.string() + ": cannot list the folder: " + ec.message());
+  if (found.empty()) throw InputError(dir.string() + ": no checkpoint (ckpt-NNNNNN.hdc) in this folder");
+  std::sort(found.rbegin(), found.rend());
+  std::string errors;
+  for (const auto& [n, p] : found) {
+    try {
+      CheckpointReader::from_file(p.string());
+      return p.string();
+    } catch (const InputError& e) {
+      log << "warning: skipping a damaged checkpoint: " << e.what() << "\n";
+      errors += std::string("\n  ") + e.what();
+    }
+  }
+  throw InputError(dir.string() + ": every checkpoint in this folder is damaged:" + errors);
+}
+
+RunResult resume_scenario(const std::string& path, Scenario& sc, const RunOptions& options, std::ostream& log) {
+  const std::string file = find_checkpoint(path, log);
+  const CheckpointReader r = CheckpointReader::from_file(file);
+  {
+    SectionReader meta = r.section(kMetaSection);
+    const std::string kind = meta.str(4096);
+    if (kind == "blow-up")
+      throw InputError(file + ": holds the state of a blow-up, for inspection (hilldem inspect); resume from the "
+                              "run's checkpoints/ folder instead");
+  }
+  restore_scenario(r, sc);
+  std::string dir = options.output_dir;
+  if (dir.empty()) {
+    const fs::path parent = fs::absolute(fs::path(file)).parent_path();
+    dir = (parent.filename() == kCheckpointFolder ? parent.parent_path() : parent).string();
+  }
+  Runner runner(sc, options, log);
+  return runner.resume(r, dir);
+}
+
+std::string describe_checkpoint(const std::string& path, std::optional<std::int64_t> ball) {
+  const CheckpointReader r = CheckpointReader::from_file(path);
+  std::string out = fmt::format("checkpoint {} (format version {})\n", path, kCheckpointFormatVersion);
+  if (r.has(kMetaSection)) {
+    SectionReader m = r.section(kMetaSection);
+    const std::string kind = m.str(4096);
+    const std::string message = m.str();
+    const std::time_t when = static_cast<std::time_t>(m.i64());
+    const std::string digest = m.str(64);
+    char stamp[64] = "?";
+    if (const std::tm* tm = std::gmtime(&when)) std::strftime(stamp, sizeof stamp, "%Y-%m-%d %H:%M:%S UTC", tm);
+    out += fmt::format("kind: {}   written: {}   state digest: {}\n", kind, stamp, digest);
+    if (!message.empty()) out += "message: " + message + "\n";
+  }
+  if (r.has("run.scenario")) {
+    SectionReader s = r.section("run.scenario");
+    out += "scenario: " + s.str(1u << 20) + "\n";
+  }
+  Simulation sim;
+  read_simulation(r, sim, false);
+  out += fmt::format("clock: step {}, t = {:.9g} s, last dt = {:.6g} s\n", sim.steps, sim.time, sim.last_dt);
+  if (r.has("run.position")) {
+    SectionReader p = r.section("run.position");
+    const std::uint64_t stage = p.u64();
+    const std::int64_t steps = p.i64();
+    out += fmt::format("position: stage {} ({} steps done inside it)\n", stage + 1, steps);
+  }
+  std::size_t wet = 0, active = 0;
+  for (std::size_t c = 0; c < sim.contacts.size(); ++c)
+    if (sim.contacts.exists[c]) {
+      active += sim.contacts.active[c];
+      wet += sim.contacts.model[c] == ModelKind::Hill && sim.contacts.moisture[c] == Moisture::Wet;
+    }
+  out += fmt::format("bodies: {} balls, {} walls; contacts: {} ({} active, {} wet), {} neighbour rows\n", sim.balls.size(),
+                     sim.walls.size(), sim.contact_count(), active, wet, sim.contacts.size());
+  out += "sections:";
+  for (const std::string& n : r.names()) out += fmt::format(" {} ({} B)", n, r.section_size(n));
+  out += "\n";
+  if (ball) {
+    const long i = sim.balls.find(*ball);
+    if (i < 0) throw InputError(path + ": no ball with id " + std::to_string(*ball) + " in this checkpoint");
+    const BallStore& b = sim.balls;
+    const auto k = static_cast<std::size_t>(i);
+    out += fmt::format("ball {}: radius {:.6g} m, mass {:.6g} kg, fixity {:#x}\n  position {} m\n  velocity {} m/s\n  spin {} rad/s\n"
+                       "  contact force {} N\n  contact moment {} N m\n  its contacts:\n",
+                       b.id[k], b.radius[k], b.mass[k], b.fixity[k], vec_text(b.position[k]), vec_text(b.velocity[k]),
+                       vec_text(b.spin[k]), vec_text(b.contact_force[k]), vec_text(b.contact_moment[k]));
+    out += ball_contacts_text(sim, k, SIZE_MAX);
+  }
+  return out;
 }
 
 }  // namespace hilldem

@@ -1,10 +1,24 @@
-// Runner: executes a scenario's stages on its Simulation, writes the CSV history and collects probes.
+// Runner: executes a scenario's stages on its Simulation, writes the CSV history and collects probes;
+// also the run's outputs and fault tolerance:
+//   * snapshots for ParaView ([snapshots], io/vtk_writer.hpp),
+//   * checkpoints ([checkpoints], io/checkpoint.hpp) from which resume_scenario continues a run
+//     bitwise as if it had never stopped: the runner saves its position inside the current stage
+//     (steps done, the motion imposed so far, saved fixities), the probes so far, the servos and how
+//     far the history and snapshot index had got,
+//   * progress on stderr (io/progress.hpp),
+//   * blow-up detection: a non-finite state or a free ball moving more than blowup_fraction × its
+//     radius in one step stops the run (RunError) with the step, the ball, its contacts and a
+//     checkpoint of the state to inspect.
 #pragma once
 
+#include <cstdint>
 #include <iosfwd>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "hilldem/io/checkpoint.hpp"
+#include "hilldem/io/progress.hpp"
 #include "hilldem/io/scenario.hpp"
 
 namespace hilldem {
@@ -18,22 +32,56 @@ struct ProbeValue {
 };
 
 struct RunOptions {
-  bool quiet = false;             // no progress lines
+  bool quiet = false;             // no stage lines, listings or progress
   std::string output_dir;         // overrides the scenario's [output] dir when not empty
-  bool write_files = true;        // false: never write the history (verify, tests)
+  bool write_files = true;        // false: never write any file (verify, tests)
+  ProgressMode progress = ProgressMode::Auto;  // Auto: in place on a terminal, plain lines otherwise
+  double progress_interval = 10.0;             // [s] between plain progress lines
+  std::ostream* progress_stream = nullptr;     // default std::cerr
+  // Tests: stop right after this step as if the process had died there (no stage-end outputs, no
+  // final checkpoint); RunResult::halted says it happened. -1: never.
+  std::int64_t halt_after_step = -1;
 };
 
 struct RunResult {
   std::vector<ProbeValue> probes;
-  std::string history_path;  // "" when none was written
+  std::string history_path;     // "" when none was written
+  std::string snapshot_dir;     // "" when no snapshots were written
+  std::string checkpoint_dir;   // "" when no checkpoints were written
+  std::string last_checkpoint;  // the newest checkpoint file written ("" when none)
+  bool halted = false;          // RunOptions::halt_after_step was reached
+  bool already_complete = false;  // resume_scenario found a finished run
   const ProbeValue* find(const std::string& label) const;
 };
 
-// Runs every stage in order. Progress and listings go to `log`. Throws RunError when a stage fails.
+// Runs every stage in order. Stage lines and listings go to `log`. Throws RunError when a stage
+// fails, InputError when an output cannot be created.
 RunResult run_scenario(Scenario& sc, const RunOptions& options, std::ostream& log);
+
+// The checkpoint to resume from: `path` itself when it is a file; for a folder (an output folder or
+// its checkpoints/ folder) the newest checkpoint that reads back intact, older ones when the newest
+// is damaged (each skipped file is reported on `log`). InputError when there is none.
+std::string find_checkpoint(const std::string& path, std::ostream& log);
+
+// Continue the run saved in a checkpoint (file or folder, as find_checkpoint). The scenario is
+// rebuilt into `sc` from the text the checkpoint carries; outputs continue in the checkpoint's output
+// folder (the parent of its checkpoints/ folder) unless options.output_dir is given. A corrupt,
+// truncated or mismatched checkpoint is an InputError naming the problem.
+RunResult resume_scenario(const std::string& path, Scenario& sc, const RunOptions& options, std::ostream& log);
+
+// Value of a history or probe quantity: an engine quantity (io/quantity.hpp), or a servo.* quantity
+// of servo `servo` (>= 0).
+double evaluate(const Scenario& sc, const Quantity& q, int servo);
 
 // One line per contact: pieces, model, rule and why, state. The "contacts" CLI command and the
 // list_contacts stage print it.
 std::string contact_listing(const Simulation& sim);
+
+// The probe table `hilldem run` prints.
+std::string probe_table(const RunResult& result);
+
+// What a checkpoint holds, in words (hilldem inspect): its kind, clock, stage position, counts and
+// sections; with `ball`, that ball's state and every contact it has.
+std::string describe_checkpoint(const std::string& path, std::optional<std::int64_t> ball);
 
 }  // namespace hilldem

@@ -1,7 +1,9 @@
 #include "hilldem/io/scenario.hpp"
 
+#include <algorithm>
 #include <fmt/format.h>
 #include <fstream>
+#include <numbers>
 #include <map>
 #include <set>
 #include <sstream>
@@ -26,6 +28,7 @@ const char* to_string(StageType t) {
     case StageType::MakeDry: return "make_dry";
     case StageType::Probe: return "probe";
     case StageType::ListContacts: return "list_contacts";
+    case StageType::SetServo: return "set_servo";
   }
   return "?";
 }
@@ -74,9 +77,13 @@ std::uint64_t read_groups(TableReader& t, GroupNames& names) {
   return mask;
 }
 
+// servo.* quantities (evaluated by the runner): field and unit.
+constexpr const char* kServoFields[][2] = {{"stress", "Pa"}, {"target_stress", "Pa"}, {"speed", "m/s"}, {"enabled", "-"}};
+
 class Reader {
  public:
-  Reader(const toml::table& root, std::string file) : root_(root, file, ""), file_(std::move(file)) {}
+  Reader(const toml::table& root, std::string file, const ScenarioLimits& limits)
+      : root_(root, file, ""), file_(std::move(file)), limits_(limits) {}
 
   Scenario read() {
     Scenario sc;
@@ -84,12 +91,15 @@ class Reader {
     sc.title = root_.string("title", "");
     read_simulation(sc);
     read_output(sc);
+    read_snapshots(sc);
+    read_checkpoints(sc);
     for (TableReader& t : root_.tables("material")) read_material(t);
     for (TableReader& t : root_.tables("ball")) read_ball(t, sc.sim);
     for (TableReader& t : root_.tables("ball_grid")) read_ball_grid(t, sc.sim);
     for (TableReader& t : root_.tables("packing")) read_packing_table(t, sc.sim);
     finish_box(sc.sim);
     for (TableReader& t : root_.tables("wall")) read_wall(t, sc.sim);
+    for (TableReader& t : root_.tables("servo")) read_servo(t, sc);
     for (TableReader& t : root_.tables("contact_model")) read_rule(t, sc.sim);
     for (TableReader& t : root_.tables("history")) read_history(t, sc);
     for (TableReader& t : root_.tables("stage")) read_stage(t, sc);
@@ -118,6 +128,7 @@ class Reader {
     s.timestep_max = t->real("timestep_max", 1e-4, Range::open(0.0, 1.0), "[s]");
     s.proximity = t->real("proximity", 0.0, Range::closed(0.0, kInf), "[m]");
     s.skin = t->real("skin", 0.0, Range::closed(0.0, kInf), "[m] (0: 0.1 x mean diameter)");
+    sc.blowup_fraction = t->real("blowup_fraction", 0.5, Range::closed(0.0, kInf), "[-] (fraction of a ball's radius per step; 0: off)");
     s.density_scaling = t->boolean("density_scaling", false);
     if (s.density_scaling && s.auto_timestep)
       t->fail("density_scaling", "needs a fixed timestep [s] (the masses are scaled to it), not \"auto\"");
@@ -144,6 +155,123 @@ class Reader {
     if (sc.history_file.empty() || sc.history_file.find('/') != std::string::npos)
       t->fail("history_file", "must be a plain file name (no '/')");
     t->finish();
+  }
+
+  void read_snapshots(Scenario& sc) {
+    auto t = root_.table("snapshots");
+    if (!t) return;
+    SnapshotSettings& s = sc.snapshots;
+    s.enabled = t->boolean("enabled", true);
+    s.every = t->integer("every", 0, 0, INT64_MAX);
+    s.at_stage_ends = t->boolean("at_stage_ends", true);
+    s.contacts = t->boolean("contacts", true);
+    s.walls = t->boolean("walls", true);
+    s.binary = t->choice("format", "binary", {"binary", "ascii"}) == "binary";
+    s.folder = t->string("folder", "snapshots");
+    if (s.folder.empty() || s.folder.find('/') != std::string::npos || s.folder == "." || s.folder == "..")
+      t->fail("folder", "must be a plain folder name (no '/')");
+    t->finish();
+  }
+
+  void read_checkpoints(Scenario& sc) {
+    auto t = root_.table("checkpoints");
+    if (!t) return;
+    CheckpointSettings& c = sc.checkpoints;
+    c.enabled = t->boolean("enabled", true);
+    c.every = t->integer("every", 0, 0, INT64_MAX);
+    c.every_seconds = t->real("every_seconds", 600.0, Range::closed(0.0, 1e9), "[s] (0: not by time)");
+    c.at_stage_ends = t->boolean("at_stage_ends", true);
+    c.keep = static_cast<int>(t->integer("keep", 2, 1, 1000));
+    t->finish();
+  }
+
+  // [[servo]]: a Servo (control/servo.hpp) on the walls named or grouped `wall`.
+  void read_servo(TableReader& t, Scenario& sc) {
+    const Simulation& sim = sc.sim;
+    const std::string name = t.string("name", std::nullopt);
+    if (name.empty()) t.fail("name", "must not be empty");
+    if (sc.find_servo(name) >= 0) t.fail("name", "servo \"" + name + "\" is defined twice");
+    const std::string wall = t.string("wall", std::nullopt);
+    std::vector<std::size_t> walls;
+    const std::uint64_t bit = sim.groups.find(wall);
+    for (std::size_t k = 0; k < sim.walls.size(); ++k)
+      if (sim.walls.walls[k].name == wall || (bit && (sim.walls.walls[k].groups & bit))) walls.push_back(k);
+    if (walls.empty()) t.fail("wall", "no wall named or grouped \"" + wall + "\"");
+    for (const ScenarioServo& other : sc.servos)
+      for (std::size_t w : walls)
+        if (std::find(other.walls.begin(), other.walls.end(), w) != other.walls.end())
+          t.fail("wall", "wall '" + sim.walls.walls[w].name + "' is already driven by servo \"" + other.name + "\"");
+    const bool radial = t.choice("mode", "axial", {"axial", "radial"}) == "radial";
+    Vec3 outward;
+    if (!radial) {
+      outward = t.vec3("outward", std::nullopt, Range::any(), "[-] (the platen's outward normal, away from the specimen)");
+      if (norm(outward) == 0.0) t.fail("outward", "must not be the zero vector");
+    }
+    ServoSettings set;
+    set.target_stress = t.real("target_stress", std::nullopt, Range::any(), "[Pa] (compression > 0)");
+    set.gain_factor = t.real("gain_factor", 0.5, Range::open_closed(0.0, 1.0), "[-]");
+    set.max_speed = t.real("max_speed", 1.0, Range::positive(), "[m/s]");
+    std::function<double(const Simulation&)> area;
+    if (radial) {
+      for (std::size_t w : walls)
+        if (sim.walls.walls[w].shape != WallShape::Cylinder)
+          t.fail("mode", "\"radial\" drives cylinders; wall '" + sim.walls.walls[w].name + "' is not one");
+    }
+    if (t.has("area") && t.is_string("area")) {
+      t.choice("area", std::nullopt, {"auto"});
+      if (radial) {
+        // Lateral area 2πR·height of each cylinder, at its current radius.
+        for (std::size_t w : walls)
+          if (!(sim.walls.walls[w].lo < sim.walls.walls[w].hi))
+            t.fail("area", "\"auto\" needs cylinders with a finite extent; wall '" + sim.walls.walls[w].name + "' is infinite");
+        area = [walls](const Simulation& s) {
+          double a = 0.0;
+          for (std::size_t w : walls) {
+            const Wall& c = s.walls.walls[w];
+            a += 2.0 * std::numbers::pi * c.radius * (c.hi - c.lo);
+          }
+          return a;
+        };
+      } else {
+        double a = 0.0;
+        for (std::size_t w : walls) {
+          const Wall& f = sim.walls.walls[w];
+          if (f.shape != WallShape::Facet)
+            t.fail("area", "\"auto\" sums facet areas; wall '" + f.name + "' is not a facet: give the area in m^2");
+          a += 0.5 * norm(cross(f.vertex[1] - f.vertex[0], f.vertex[2] - f.vertex[0]));
+        }
+        area = [a](const Simulation&) { return a; };
+      }
+    } else {
+      const double a = t.real("area", std::nullopt, Range::positive(), "[m^2] (or \"auto\")");
+      area = [a](const Simulation&) { return a; };
+    }
+    const bool enabled = t.boolean("enabled", true);
+    t.finish();
+    ScenarioServo s{name, wall, Servo(radial ? Servo::Mode::Radial : Servo::Mode::Axial, walls, outward, set, area), walls};
+    s.servo.enabled = enabled;
+    sc.servos.push_back(std::move(s));
+  }
+
+  // A servo.* quantity (histories and probes): the servo index; the field and unit go into q.
+  int read_servo_quantity(TableReader& t, const Scenario& sc, Quantity& q) {
+    q.name = t.string("quantity", std::nullopt);
+    q.field = q.name.substr(6);
+    const char* unit = nullptr;
+    for (const auto& f : kServoFields)
+      if (q.field == f[0]) unit = f[1];
+    if (!unit) t.fail("quantity", "unknown quantity \"" + q.name + "\"; servo quantities: servo.stress [Pa], servo.target_stress [Pa], servo.speed [m/s], servo.enabled [-]");
+    q.unit = unit;
+    const std::string name = t.string("servo", std::nullopt);
+    const int k = sc.find_servo(name);
+    if (k < 0) t.fail("servo", "no [[servo]] named \"" + name + "\"");
+    q.target_text = "servo " + name;
+    return k;
+  }
+
+  static bool is_servo_quantity(const TableReader& t) {
+    const auto q = t.peek_string("quantity");
+    return q && q->rfind("servo.", 0) == 0;
   }
 
   void read_material(TableReader& t) {
@@ -182,6 +310,8 @@ class Reader {
   }
 
   void add_ball(TableReader& t, Simulation& sim, const BallInit& b) {
+    if (sim.balls.size() >= limits_.max_balls)
+      t.fail("id", "more than " + std::to_string(limits_.max_balls) + " balls (the limit for one scenario)");
     if (!ids_.insert(b.id).second) t.fail("id", "ball id " + std::to_string(b.id) + " is used twice");
     sim.balls.add(b);
   }
@@ -207,6 +337,10 @@ class Reader {
       t.fail("first_id", "ids would overflow a 64-bit integer");
     const double spacing = t.real("spacing", std::nullopt, Range::positive(), "[m]");
     t.finish();
+    const double total = counts.x * counts.y * counts.z;
+    if (total + static_cast<double>(sim.balls.size()) > static_cast<double>(limits_.max_balls))
+      t.fail("counts", fmt::format("{:g} balls: more than {} balls in the scenario (the limit for one scenario)", total,
+                                   limits_.max_balls));
     for (int k = 0; k < static_cast<int>(counts.z); ++k)
       for (int j = 0; j < static_cast<int>(counts.y); ++j)
         for (int i = 0; i < static_cast<int>(counts.x); ++i) {
@@ -232,6 +366,8 @@ class Reader {
     t.finish();
     const std::filesystem::path base = std::filesystem::path(file_).parent_path();
     const std::string path = std::filesystem::path(file).is_absolute() ? file : (base / file).string();
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) t.fail("file", "\"" + path + "\" is not a readable regular file");
     Packing p;
     try {
       p = read_packing(path, format == "lammps" ? PackingFormat::Lammps : PackingFormat::Xyzr);
@@ -421,7 +557,8 @@ class Reader {
       t.fail("name", "must be a non-empty name without commas, quotes or newlines");
     for (const History& o : sc.histories)
       if (o.name == h.name) t.fail("name", "history \"" + h.name + "\" is defined twice");
-    h.quantity = read_quantity(t, sc.sim);
+    if (is_servo_quantity(t)) h.servo = read_servo_quantity(t, sc, h.quantity);
+    else h.quantity = read_quantity(t, sc.sim);
     t.finish();
     sc.histories.push_back(h);
   }
@@ -462,7 +599,7 @@ class Reader {
     Stage s;
     const std::string type = t.choice("type", std::nullopt,
                                       {"cycle", "solve", "translate", "rotate", "set", "set_contacts",
-                                       "set_simulation", "make_wet", "make_dry", "probe", "list_contacts"});
+                                       "set_simulation", "make_wet", "make_dry", "probe", "list_contacts", "set_servo"});
     s.name = t.string("name", type == "probe" && t.is_string("label") ? *t.peek_string("label") : type);
     const Simulation& sim = sc.sim;
     if (type == "cycle") {
@@ -529,11 +666,23 @@ class Reader {
       s.label = t.string("label", std::nullopt);
       if (s.label.empty()) t.fail("label", "must not be empty");
       if (!labels_.insert(s.label).second) t.fail("label", "probe label \"" + s.label + "\" is used twice");
-      s.quantity = read_quantity(t, sim);
+      if (is_servo_quantity(t)) s.servo = read_servo_quantity(t, sc, s.quantity);
+      else s.quantity = read_quantity(t, sim);
       s.ratio_to = t.string("ratio_to", "");
       if (!s.ratio_to.empty() && (s.ratio_to == s.label || !labels_.count(s.ratio_to)))
         t.fail("ratio_to", "must name an earlier probe label; got \"" + s.ratio_to + "\"");
       s.scale = t.real("scale", 1.0, Range::any(), "[-]");
+    } else if (type == "set_servo") {
+      s.type = StageType::SetServo;
+      const std::string name = t.string("servo", std::nullopt);
+      s.servo = sc.find_servo(name);
+      if (s.servo < 0) t.fail("servo", "no [[servo]] named \"" + name + "\"");
+      if (t.has("target_stress")) s.target_stress = t.real("target_stress", std::nullopt, Range::any(), "[Pa]");
+      if (t.has("gain_factor")) s.gain_factor = t.real("gain_factor", std::nullopt, Range::open_closed(0.0, 1.0), "[-]");
+      if (t.has("max_speed")) s.max_speed = t.real("max_speed", std::nullopt, Range::positive(), "[m/s]");
+      if (t.has("enabled")) s.enabled = t.boolean("enabled", true);
+      if (!s.target_stress && !s.gain_factor && !s.max_speed && !s.enabled)
+        t.fail("servo", "set_servo needs at least one of target_stress, gain_factor, max_speed, enabled");
     } else {
       s.type = StageType::ListContacts;
     }
@@ -543,6 +692,7 @@ class Reader {
 
   TableReader root_;
   std::string file_;
+  ScenarioLimits limits_;
   std::map<std::string, Material> materials_;
   std::set<std::int64_t> ids_;
   std::set<std::string> wall_names_, labels_;
@@ -551,9 +701,17 @@ class Reader {
 
 }  // namespace
 
-Scenario load_scenario(const std::string& text, const std::string& file) {
+int Scenario::find_servo(const std::string& name) const {
+  for (std::size_t k = 0; k < servos.size(); ++k)
+    if (servos[k].name == name) return static_cast<int>(k);
+  return -1;
+}
+
+Scenario load_scenario(const std::string& text, const std::string& file, const ScenarioLimits& limits) {
   const toml::table root = parse_toml(text, file);
-  return Reader(root, file).read();
+  Scenario sc = Reader(root, file, limits).read();
+  sc.text = text;
+  return sc;
 }
 
 Scenario load_scenario_file(const std::string& path) {

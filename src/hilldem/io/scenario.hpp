@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "hilldem/control/servo.hpp"
 #include "hilldem/engine/simulation.hpp"
 #include "hilldem/io/quantity.hpp"
 
@@ -19,7 +20,7 @@ struct Selection {
   std::string text;                // "ball 2", "group top", "wall floor"
 };
 
-enum class StageType { Cycle, Solve, Translate, Rotate, Set, SetContacts, SetSimulation, MakeWet, MakeDry, Probe, ListContacts };
+enum class StageType { Cycle, Solve, Translate, Rotate, Set, SetContacts, SetSimulation, MakeWet, MakeDry, Probe, ListContacts, SetServo };
 
 struct Stage {
   StageType type = StageType::Cycle;
@@ -45,15 +46,55 @@ struct Stage {
   Quantity quantity;
   std::string ratio_to;
   double scale = 1.0;
+  // set_servo: the servo (index into Scenario::servos) and what changes; probe of a servo.* quantity:
+  // the servo it reads (-1: an engine quantity)
+  int servo = -1;
+  std::optional<double> target_stress, gain_factor, max_speed;
+  std::optional<bool> enabled;
 };
 
 struct History {
   std::string name;
   Quantity quantity;
+  int servo = -1;  // servo.* quantities: index into Scenario::servos (quantity.field names the value)
+};
+
+// A scenario-level servo ([[servo]]): control/servo.hpp's Servo driving walls to a target stress,
+// registered as a Simulation controller by the runner.
+struct ScenarioServo {
+  std::string name;
+  std::string wall_text;  // the wall name or group it drives
+  Servo servo;
+  std::vector<std::size_t> walls;  // the walls it drives (indices)
+};
+
+// [snapshots]: VTK files for ParaView (io/vtk_writer.hpp), into <output dir>/<folder>.
+struct SnapshotSettings {
+  bool enabled = false;        // on when the table is present
+  std::int64_t every = 0;      // every N steps (0: only at stage ends)
+  bool at_stage_ends = true;   // after every stage that cycles or changes the state
+  bool contacts = true, walls = true;
+  bool binary = true;          // "binary" (appended raw) or "ascii"
+  std::string folder = "snapshots";
+};
+
+// [checkpoints]: restart files into <output dir>/checkpoints (io/checkpoint.hpp).
+struct CheckpointSettings {
+  bool enabled = true;          // whenever there is an output folder, unless disabled
+  std::int64_t every = 0;       // every N steps (0: not by steps)
+  double every_seconds = 600;   // every S seconds of wall-clock time (0: not by time)
+  bool at_stage_ends = true;    // after every stage that cycles or changes the state
+  int keep = 2;                 // newest checkpoints kept (older ones are deleted)
+};
+
+// Limits that keep hostile or mistaken input from exhausting memory.
+struct ScenarioLimits {
+  std::uint64_t max_balls = 10'000'000;
 };
 
 struct Scenario {
   std::string file;
+  std::string text;  // the TOML source (checkpoints carry it, so a run resumes without the file)
   std::string title;
   Simulation sim;
   std::vector<Stage> stages;
@@ -61,10 +102,16 @@ struct Scenario {
   std::int64_t history_every = 1;
   std::string output_dir;    // "" = no files written
   std::string history_file = "history.csv";
+  std::vector<ScenarioServo> servos;
+  SnapshotSettings snapshots;
+  CheckpointSettings checkpoints;
+  double blowup_fraction = 0.5;  // a free ball moving more than this × its radius in one step stops the run (0: off)
+  // Index of the servo named `name`, or -1.
+  int find_servo(const std::string& name) const;
 };
 
 // Parse and validate; `file` names the source in error messages. Throws InputError.
-Scenario load_scenario(const std::string& text, const std::string& file);
+Scenario load_scenario(const std::string& text, const std::string& file, const ScenarioLimits& limits = {});
 Scenario load_scenario_file(const std::string& path);
 
 const char* to_string(StageType t);

@@ -1,0 +1,285 @@
+#include "hilldem/io/checkpoint.hpp"
+
+#include <array>
+#include <bit>
+#include <cerrno>
+#include <fcntl.h>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <unistd.h>
+
+#include "hilldem/io/fault_injection.hpp"
+
+namespace hilldem {
+
+static_assert(std::endian::native == std::endian::little, "checkpoints are written little-endian");
+
+namespace {
+
+constexpr char kMagic[8] = {'H', 'D', 'M', 'C', 'K', 'P', 'T', '\n'};
+constexpr char kTrailer[8] = {'H', 'D', 'M', 'E', 'N', 'D', '\n', '\0'};
+constexpr std::size_t kHeaderBytes = 8 + 4 + 4 + 8 + 4;
+constexpr std::size_t kMaxSectionName = 255;
+
+std::array<std::uint32_t, 256> make_crc_table() {
+  std::array<std::uint32_t, 256> t{};
+  for (std::uint32_t n = 0; n < 256; ++n) {
+    std::uint32_t c = n;
+    for (int k = 0; k < 8; ++k) c = (c & 1u) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+    t[n] = c;
+  }
+  return t;
+}
+
+template <class T>
+void put(std::string& out, T v) {
+  out.append(reinterpret_cast<const char*>(&v), sizeof(T));
+}
+
+template <class T>
+T get_at(const std::string& in, std::size_t offset) {
+  T v;
+  std::memcpy(&v, in.data() + offset, sizeof(T));
+  return v;
+}
+
+std::string errno_text() { return std::strerror(errno); }
+
+void write_atomically(const std::string& path, std::string_view bytes, bool checkpoint);
+
+}  // namespace
+
+std::uint32_t crc32(const void* data, std::size_t size, std::uint32_t crc) {
+  static const std::array<std::uint32_t, 256> table = make_crc_table();
+  const auto* p = static_cast<const unsigned char*>(data);
+  crc = ~crc;
+  for (std::size_t i = 0; i < size; ++i) crc = table[(crc ^ p[i]) & 0xFFu] ^ (crc >> 8);
+  return ~crc;
+}
+
+// ---- SectionReader ----
+
+bool SectionReader::boolean() {
+  const std::uint8_t v = u8();
+  if (v > 1) fail("a boolean holds " + std::to_string(v));
+  return v == 1;
+}
+
+std::string SectionReader::str(std::size_t max_len) {
+  const std::uint64_t n = u64();
+  if (n > remaining()) fail("a string of " + std::to_string(n) + " bytes is truncated");
+  if (n > max_len) fail("a string of " + std::to_string(n) + " bytes is longer than " + std::to_string(max_len));
+  std::string s(data_.substr(pos_, n));
+  pos_ += n;
+  return s;
+}
+
+std::uint64_t SectionReader::count(std::size_t min_item_bytes, std::uint64_t max_count) {
+  const std::uint64_t n = u64();
+  if (n > max_count) fail("a count of " + std::to_string(n) + " exceeds the limit " + std::to_string(max_count));
+  if (min_item_bytes > 0 && n > remaining() / min_item_bytes)
+    fail("a count of " + std::to_string(n) + " items does not fit in the " + std::to_string(remaining()) +
+         " bytes left");
+  return n;
+}
+
+void SectionReader::finish() const {
+  if (remaining() != 0) fail(std::to_string(remaining()) + " unexpected bytes at the end");
+}
+
+void SectionReader::fail(const std::string& message) const { throw InputError(context_ + ": " + message); }
+
+// ---- CheckpointWriter ----
+
+SectionWriter& CheckpointWriter::section(const std::string& name, std::uint32_t version) {
+  if (name.empty() || name.size() > kMaxSectionName) throw RunError("checkpoint section names are 1-255 bytes: '" + name + "'");
+  for (const Section& s : sections_)
+    if (s.name == name) throw RunError("checkpoint section '" + name + "' written twice");
+  sections_.push_back({name, version, {}});
+  return sections_.back().data;
+}
+
+std::string CheckpointWriter::bytes() const {
+  std::string body;
+  for (const Section& s : sections_) {
+    const std::size_t start = body.size();
+    put<std::uint32_t>(body, static_cast<std::uint32_t>(s.name.size()));
+    body += s.name;
+    put<std::uint32_t>(body, s.version);
+    put<std::uint64_t>(body, s.data.bytes().size());
+    body += s.data.bytes();
+    put<std::uint32_t>(body, crc32(body.data() + start, body.size() - start));
+  }
+  std::string out(kMagic, sizeof kMagic);
+  put<std::uint32_t>(out, kCheckpointFormatVersion);
+  put<std::uint32_t>(out, static_cast<std::uint32_t>(sections_.size()));
+  put<std::uint64_t>(out, body.size());
+  put<std::uint32_t>(out, crc32(out.data(), out.size()));
+  out += body;
+  out.append(kTrailer, sizeof kTrailer);
+  return out;
+}
+
+void CheckpointWriter::write_file(const std::string& path) const { write_atomically(path, bytes(), true); }
+
+void write_file_atomically(const std::string& path, std::string_view bytes) { write_atomically(path, bytes, false); }
+
+namespace {
+void write_all(int fd, const char* data, std::size_t size, const std::string& tmp) {
+  std::size_t done = 0;
+  while (done < size) {
+    const ssize_t n = ::write(fd, data + done, size - done);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      const std::string why = errno_text();
+      ::close(fd);
+      ::unlink(tmp.c_str());
+      throw RunError(tmp + ": write failed: " + why);
+    }
+    done += static_cast<std::size_t>(n);
+  }
+}
+
+void write_atomically(const std::string& path, std::string_view bytes, bool checkpoint) {
+  namespace fs = std::filesystem;
+  const fs::path target(path);
+  const fs::path tmp = target.string() + ".tmp." + std::to_string(::getpid());
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw RunError(tmp.string() + ": cannot create: " + errno_text());
+  const std::size_t half = bytes.size() / 2;
+  write_all(fd, bytes.data(), half, tmp.string());
+  // Fault injection (tests only): die by SIGKILL with the temporary file half written.
+  if (checkpoint) fault_injection().on_checkpoint_half_written();
+  write_all(fd, bytes.data() + half, bytes.size() - half, tmp.string());
+  if (::fsync(fd) != 0) {
+    const std::string why = errno_text();
+    ::close(fd);
+    ::unlink(tmp.c_str());
+    throw RunError(tmp.string() + ": fsync failed: " + why);
+  }
+  if (::close(fd) != 0) {
+    ::unlink(tmp.c_str());
+    throw RunError(tmp.string() + ": close failed: " + errno_text());
+  }
+  if (::rename(tmp.c_str(), target.c_str()) != 0) {
+    const std::string why = errno_text();
+    ::unlink(tmp.c_str());
+    throw RunError(target.string() + ": rename from the temporary file failed: " + why);
+  }
+  // The rename is durable only once the folder entry is on disk.
+  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd >= 0) {
+    ::fsync(dfd);
+    ::close(dfd);
+  }
+}
+
+}  // namespace
+
+// ---- CheckpointReader ----
+
+CheckpointReader CheckpointReader::from_file(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw InputError(path + ": is a folder, not a checkpoint file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open the checkpoint file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) throw InputError(path + ": cannot read the checkpoint file");
+  return from_bytes(std::move(ss).str(), path);
+}
+
+CheckpointReader CheckpointReader::from_bytes(std::string bytes, const std::string& source) {
+  auto fail = [&](const std::string& m) -> void { throw InputError(source + ": " + m); };
+  const std::size_t total = bytes.size();
+  if (total == 0) fail("empty file: not a hilldem checkpoint");
+  if (total < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
+    fail("not a hilldem checkpoint (the file does not start with the checkpoint magic)");
+  if (total < kHeaderBytes) fail("truncated checkpoint: " + std::to_string(total) + " bytes, shorter than the header");
+  const auto version = get_at<std::uint32_t>(bytes, 8);
+  const auto n_sections = get_at<std::uint32_t>(bytes, 12);
+  const auto body = get_at<std::uint64_t>(bytes, 16);
+  const auto header_crc = get_at<std::uint32_t>(bytes, 24);
+  if (crc32(bytes.data(), 24) != header_crc) fail("corrupt checkpoint: header checksum mismatch");
+  if (version != kCheckpointFormatVersion)
+    fail("checkpoint format version " + std::to_string(version) + "; this hilldem reads version " +
+         std::to_string(kCheckpointFormatVersion));
+  const std::size_t expected = kHeaderBytes + sizeof kTrailer;
+  if (body > total || total - std::min<std::size_t>(total, expected) < body) {
+    fail("truncated checkpoint: the header announces " + std::to_string(body + expected) + " bytes, the file has " +
+         std::to_string(total));
+  }
+  if (total != expected + body)
+    fail("checkpoint size mismatch: the header announces " + std::to_string(body + expected) + " bytes, the file has " +
+         std::to_string(total) + " (trailing data)");
+  if (std::memcmp(bytes.data() + total - sizeof kTrailer, kTrailer, sizeof kTrailer) != 0)
+    fail("corrupt checkpoint: the end marker is missing");
+
+  CheckpointReader r;
+  r.source_ = source;
+  std::size_t pos = kHeaderBytes;
+  const std::size_t end = kHeaderBytes + body;
+  for (std::uint32_t k = 0; k < n_sections; ++k) {
+    const std::size_t start = pos;
+    const std::string where = "section " + std::to_string(k + 1) + " of " + std::to_string(n_sections);
+    if (end - pos < 4) fail("truncated checkpoint: " + where + " has no header");
+    const auto name_len = get_at<std::uint32_t>(bytes, pos);
+    pos += 4;
+    if (name_len == 0 || name_len > kMaxSectionName) fail("corrupt checkpoint: " + where + " has a name of " + std::to_string(name_len) + " bytes");
+    if (end - pos < name_len + 4 + 8) fail("truncated checkpoint: " + where + " has no header");
+    std::string name = bytes.substr(pos, name_len);
+    pos += name_len;
+    const auto sversion = get_at<std::uint32_t>(bytes, pos);
+    pos += 4;
+    const auto size = get_at<std::uint64_t>(bytes, pos);
+    pos += 8;
+    if (size > end - pos || end - pos - size < 4)
+      fail("truncated checkpoint: " + where + " ('" + name + "', " + std::to_string(size) + " bytes) runs past the end");
+    const std::size_t payload = pos;
+    pos += size;
+    const auto crc = get_at<std::uint32_t>(bytes, pos);
+    if (crc32(bytes.data() + start, pos - start) != crc)
+      fail("corrupt checkpoint: section '" + name + "' fails its checksum");
+    pos += 4;
+    for (const Entry& e : r.entries_)
+      if (e.name == name) fail("corrupt checkpoint: section '" + name + "' appears twice");
+    r.entries_.push_back({std::move(name), sversion, payload, static_cast<std::size_t>(size)});
+  }
+  if (pos != end) fail("corrupt checkpoint: " + std::to_string(end - pos) + " bytes after the last section");
+  r.bytes_ = std::move(bytes);
+  return r;
+}
+
+bool CheckpointReader::has(const std::string& name) const {
+  for (const Entry& e : entries_)
+    if (e.name == name) return true;
+  return false;
+}
+
+SectionReader CheckpointReader::section(const std::string& name, std::uint32_t max_version) const {
+  for (const Entry& e : entries_)
+    if (e.name == name) {
+      if (e.version > max_version || e.version == 0)
+        throw InputError(source_ + ": section '" + name + "' has version " + std::to_string(e.version) +
+                         "; this hilldem reads up to version " + std::to_string(max_version));
+      return SectionReader(std::string_view(bytes_).substr(e.offset, e.size), source_ + ": section '" + name + "'",
+                           e.version);
+    }
+  throw InputError(source_ + ": the checkpoint has no section '" + name + "'");
+}
+
+std::vector<std::string> CheckpointReader::names() const {
+  std::vector<std::string> out;
+  for (const Entry& e : entries_) out.push_back(e.name);
+  return out;
+}
+
+std::size_t CheckpointReader::section_size(const std::string& name) const {
+  for (const Entry& e : entries_)
+    if (e.name == name) return e.size;
+  return 0;
+}
+
+}  // namespace hilldem
