@@ -20,7 +20,13 @@ struct ContactKey {
   std::uint32_t a = 0;  // ball index (piece 1)
   ContactKind kind = ContactKind::BallBall;
   std::uint32_t b = 0;  // ball index (> a) or wall index (piece 2)
-  friend auto operator<=>(const ContactKey&, const ContactKey&) = default;
+  friend bool operator==(const ContactKey&, const ContactKey&) = default;
+  // Rows are ordered by kind first: all ball-ball rows form one block, then all ball-wall rows.
+  friend auto operator<=>(const ContactKey& x, const ContactKey& y) {
+    if (auto c = x.kind <=> y.kind; c != 0) return c;
+    if (auto c = x.a <=> y.a; c != 0) return c;
+    return x.b <=> y.b;
+  }
 };
 
 class ContactStore {

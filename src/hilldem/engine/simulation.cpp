@@ -244,17 +244,13 @@ void Simulation::rebuild(double proximity) {
   ++rebuilds_;
 }
 
-void Simulation::force_pass(double dt) {
-  const std::size_t rows = contacts.size();
+// One row, any model and kind (the general path). Returns false on a non-finite force.
+bool Simulation::force_row(std::size_t c, double dt) {
   const double proximity = settings.proximity;
   const bool want_stiffness = settings.auto_timestep || settings.density_scaling;
   const PeriodicBox& box = settings.box;
   const Vec3* pos = balls.position.data();
   const double* rad = balls.radius.data();
-  bool bad = false;
-  std::size_t bad_row = 0;
-#pragma omp parallel for schedule(static) if (rows > kParallelMin)
-  for (std::size_t c = 0; c < rows; ++c) {
     const ContactKey key = contacts.key[c];
     const std::size_t a = key.a;
     const bool ball2 = key.kind == ContactKind::BallBall;
@@ -272,17 +268,17 @@ void Simulation::force_pass(double dt) {
       const double rsum = r1 + rad[key.b];
       if (!contacts.exists[c]) {
         const double reach = rsum + proximity;
-        if (dist2 > reach * reach) continue;  // a neighbour pair, not a contact
+        if (dist2 > reach * reach) return true;  // a neighbour pair, not a contact
       }
       const double dist = std::sqrt(dist2);
       normal = dist > 0.0 ? d / dist : contacts.normal[c];  // coincident centres: keep the old normal
       gap = dist - rsum;
     } else {
       const auto touch = wall_touch(walls.walls[key.b], x1, r1);
-      if (!touch && !contacts.exists[c]) continue;
+      if (!touch && !contacts.exists[c]) return true;
       normal = touch ? touch->normal : contacts.normal[c];
       gap = touch ? touch->gap : std::numeric_limits<double>::infinity();
-      if (!contacts.exists[c] && gap > proximity) continue;
+      if (!contacts.exists[c] && gap > proximity) return true;
     }
     if (!contacts.exists[c]) contacts.create(c, normal);  // created by proximity
     const double arm1 = r1 + 0.5 * gap;                   // |x_c − x_1|
@@ -325,7 +321,7 @@ void Simulation::force_pass(double dt) {
       contacts.remove(c);
       contacts.gap[c] = gap;
       contacts.normal[c] = normal;
-      continue;
+      return true;
     }
     // Accumulated shear displacement (reported, not used by the laws): rotated with the plane.
     contacts.shear_disp[c] = active ? rotation.rotate(contacts.shear_disp[c]) + kin.shear_rate() * dt : Vec3{};
@@ -340,12 +336,18 @@ void Simulation::force_pass(double dt) {
     contacts.active[c] = active;
     contacts.k_tran[c] = stiff.kn + stiff.ks;
     contacts.k_shear[c] = stiff.ks;
-    if (!std::isfinite(force.x + force.y + force.z)) {
-#pragma omp critical(hilldem_bad_force)
-      if (!bad || c < bad_row) bad = true, bad_row = c;
-    }
-  }
-  if (bad) {
+    return std::isfinite(force.x + force.y + force.z);
+}
+
+void Simulation::force_pass(double dt) {
+  const std::size_t rows = contacts.size();
+  // Each row writes only its own columns; the first failing row is found by a min-reduction, so
+  // the outcome does not depend on the thread count.
+  std::size_t bad_row = rows;
+#pragma omp parallel for schedule(static) reduction(min : bad_row) if (rows > kParallelMin)
+  for (std::size_t c = 0; c < rows; ++c)
+    if (!force_row(c, dt)) bad_row = std::min(bad_row, c);
+  if (bad_row < rows) {
     const ContactKey& key = contacts.key[bad_row];
     std::ostringstream msg;
     msg << "non-finite contact force at step " << steps + 1 << " between ball " << balls.id[key.a] << " and "

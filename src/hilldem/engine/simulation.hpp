@@ -117,6 +117,8 @@ class Simulation {
   void rebuild(double reach);
   void rebuild_if_needed();
   void force_pass(double dt);
+  // The force-displacement law of one row (any model and kind); false on a non-finite force.
+  bool force_row(std::size_t c, double dt);
   void collect_forces();
   void compute_mapping(ContactStore& store, std::size_t c) const;
   // Σ over ball i's active contacts: k_tran = Σ(k̂_n + k̂_s) [N/m], k_rot = Σ k̂_s |x_c − x|² [N m].
