@@ -46,7 +46,7 @@ T get_at(const std::string& in, std::size_t offset) {
 
 std::string errno_text() { return std::strerror(errno); }
 
-void write_atomically(const std::string& path, std::string_view bytes, bool checkpoint);
+void write_atomically(const std::string& path, std::string_view bytes, bool checkpoint, bool durable);
 
 }  // namespace
 
@@ -121,9 +121,11 @@ std::string CheckpointWriter::bytes() const {
   return out;
 }
 
-void CheckpointWriter::write_file(const std::string& path) const { write_atomically(path, bytes(), true); }
+void CheckpointWriter::write_file(const std::string& path) const { write_atomically(path, bytes(), true, true); }
 
-void write_file_atomically(const std::string& path, std::string_view bytes) { write_atomically(path, bytes, false); }
+void write_file_atomically(const std::string& path, std::string_view bytes, bool durable) {
+  write_atomically(path, bytes, false, durable);
+}
 
 namespace {
 void write_all(int fd, const char* data, std::size_t size, const std::string& tmp) {
@@ -141,7 +143,7 @@ void write_all(int fd, const char* data, std::size_t size, const std::string& tm
   }
 }
 
-void write_atomically(const std::string& path, std::string_view bytes, bool checkpoint) {
+void write_atomically(const std::string& path, std::string_view bytes, bool checkpoint, bool durable) {
   namespace fs = std::filesystem;
   const fs::path target(path);
   const fs::path tmp = target.string() + ".tmp." + std::to_string(::getpid());
@@ -152,7 +154,7 @@ void write_atomically(const std::string& path, std::string_view bytes, bool chec
   // Fault injection (tests only): die by SIGKILL with the temporary file half written.
   if (checkpoint) fault_injection().on_checkpoint_half_written();
   write_all(fd, bytes.data() + half, bytes.size() - half, tmp.string());
-  if (::fsync(fd) != 0) {
+  if (durable && ::fsync(fd) != 0) {
     const std::string why = errno_text();
     ::close(fd);
     ::unlink(tmp.c_str());
@@ -167,6 +169,7 @@ void write_atomically(const std::string& path, std::string_view bytes, bool chec
     ::unlink(tmp.c_str());
     throw RunError(target.string() + ": rename from the temporary file failed: " + why);
   }
+  if (!durable) return;
   // The rename is durable only once the folder entry is on disk.
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
   const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);

@@ -88,6 +88,7 @@ class SectionReader {
   template <class T>
   void column(std::vector<T>& v, const char* what) {
     static_assert(std::is_trivially_copyable_v<T>);
+    if (remaining() < 12) fail(std::string("column '") + what + "' is truncated");
     const std::uint64_t n = u64();
     const std::uint32_t size = u32();
     if (size != sizeof(T))
@@ -163,8 +164,10 @@ class CheckpointReader {
   std::vector<Entry> entries_;
 };
 
-// Write `bytes` to `path` atomically (see CheckpointWriter::write_file). Also used for small index
-// files (.pvd) that must never be seen half-written.
-void write_file_atomically(const std::string& path, std::string_view bytes);
+// Write `bytes` to `path` atomically: a temporary file in the same folder, renamed over `path`, so
+// readers never see a half-written file. With `durable` the data and the rename are also fsync'ed
+// (checkpoints); without, a power failure may lose the newest version (snapshots, which a rerun or a
+// resume rewrites).
+void write_file_atomically(const std::string& path, std::string_view bytes, bool durable = true);
 
 }  // namespace hilldem

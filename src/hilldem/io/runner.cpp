@@ -248,6 +248,7 @@ class Runner {
     sim_.update_forces();
     if (history_) history_->sample(sim_);
     if (snapshots_) snapshots_->write(sim_);
+    checkpoint("start");  // a run killed before its first periodic checkpoint can still be resumed
     return run_stages();
   }
 

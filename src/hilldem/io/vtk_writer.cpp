@@ -167,7 +167,7 @@ std::vector<std::string> group_names(const GroupNames& g) {
   return names;
 }
 
-void save(const std::string& path, PolyFile& f) { write_file_atomically(path, f.xml()); }
+void save(const std::string& path, PolyFile& f) { write_file_atomically(path, f.xml(), false); }
 
 // Bounding box of the ball centres ± radii (a unit box around the origin when there are no balls).
 std::pair<Vec3, Vec3> ball_bounds(const Simulation& sim) {
@@ -395,7 +395,7 @@ void SnapshotSeries::write_index() const {
     for (const SnapshotEntry& e : entries_)
       out += fmt::format("    <DataSet timestep=\"{:.17g}\" group=\"\" part=\"0\" file=\"{}_{:06}.vtp\"/>\n", e.time, kind, e.index);
     out += "  </Collection>\n</VTKFile>\n";
-    write_file_atomically((dir / (std::string(kind) + ".pvd")).string(), out);
+    write_file_atomically((dir / (std::string(kind) + ".pvd")).string(), out, false);
   }
 }
 
