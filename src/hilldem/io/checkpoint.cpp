@@ -239,7 +239,7 @@ CheckpointReader CheckpointReader::from_bytes(std::string bytes, const std::stri
     const auto size = get_at<std::uint64_t>(bytes, pos);
     pos += 8;
     if (size > end - pos || end - pos - size < 4)
-      fail("truncated checkpoint: " + where + " ('" + name + "', " + std::to_string(size) + " bytes) runs past the end");
+      fail("corrupt or truncated checkpoint: " + where + " ('" + name + "', " + std::to_string(size) + " bytes) runs past the end");
     const std::size_t payload = pos;
     pos += size;
     const auto crc = get_at<std::uint32_t>(bytes, pos);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <ctime>
 #include <filesystem>
 #include <fmt/format.h>
@@ -229,13 +230,24 @@ std::string ball_contacts_text(const Simulation& sim, std::size_t i, std::size_t
   return n == 0 ? "    (no contacts)\n" : out;
 }
 
+// Seconds between plain progress lines: HILLDEM_PROGRESS_INTERVAL when set, else the option.
+double progress_interval(const RunOptions& o) {
+  const char* env = std::getenv("HILLDEM_PROGRESS_INTERVAL");
+  if (!env || !*env) return o.progress_interval;
+  char* end = nullptr;
+  const double v = std::strtod(env, &end);
+  if (end == env || *end != '\0' || !(v > 0.0) || !std::isfinite(v))
+    throw InputError(std::string("HILLDEM_PROGRESS_INTERVAL must be a positive number of seconds; got \"") + env + "\"");
+  return v;
+}
+
 class Runner {
  public:
   Runner(Scenario& sc, const RunOptions& options, std::ostream& log)
       : sc_(sc), sim_(sc.sim), opt_(options), log_(log),
         progress_(options.progress_stream ? *options.progress_stream : std::cerr,
                   options.quiet ? ProgressMode::Off : options.progress,
-                  !options.progress_stream && ::isatty(STDERR_FILENO) == 1, options.progress_interval) {}
+                  !options.progress_stream && ::isatty(STDERR_FILENO) == 1, progress_interval(options)) {}
 
   ~Runner() {
     sim_.observers.clear();
