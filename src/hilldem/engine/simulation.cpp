@@ -251,92 +251,96 @@ bool Simulation::force_row(std::size_t c, double dt) {
   const PeriodicBox& box = settings.box;
   const Vec3* pos = balls.position.data();
   const double* rad = balls.radius.data();
-    const ContactKey key = contacts.key[c];
-    const std::size_t a = key.a;
-    const bool ball2 = key.kind == ContactKind::BallBall;
-    const Vec3 x1 = pos[a];
-    const double r1 = rad[a];
+  const ContactKey key = contacts.key[c];
+  const std::size_t a = key.a;
+  const bool ball2 = key.kind == ContactKind::BallBall;
+  const Vec3 x1 = pos[a];
+  const double r1 = rad[a];
 
-    // Geometry (spec §1.1). Neighbour pairs that are not contacts are rejected before any sqrt.
-    Vec3 normal;
-    double gap;
-    if (ball2) {
-      Vec3 x2 = pos[key.b];
-      if (contacts.image[c] != kNoImage) x2 += image_shift(contacts.image[c], box);
-      const Vec3 d = x2 - x1;
-      const double dist2 = norm2(d);
-      const double rsum = r1 + rad[key.b];
-      if (!contacts.exists[c]) {
-        const double reach = rsum + proximity;
-        if (dist2 > reach * reach) return true;  // a neighbour pair, not a contact
-      }
-      const double dist = std::sqrt(dist2);
-      normal = dist > 0.0 ? d / dist : contacts.normal[c];  // coincident centres: keep the old normal
-      gap = dist - rsum;
-    } else {
-      const auto touch = wall_touch(walls.walls[key.b], x1, r1);
-      if (!touch && !contacts.exists[c]) return true;
-      normal = touch ? touch->normal : contacts.normal[c];
-      gap = touch ? touch->gap : std::numeric_limits<double>::infinity();
-      if (!contacts.exists[c] && gap > proximity) return true;
+  // Geometry (spec §1.1). Neighbour pairs that are not contacts are rejected before any sqrt.
+  Vec3 normal;
+  double gap;
+  if (ball2) {
+    Vec3 x2 = pos[key.b];
+    if (contacts.image[c] != kNoImage) x2 += image_shift(contacts.image[c], box);
+    const Vec3 d = x2 - x1;
+    const double dist2 = norm2(d);
+    const double rsum = r1 + rad[key.b];
+    if (!contacts.exists[c]) {
+      const double reach = rsum + proximity;
+      if (dist2 > reach * reach) return true;  // a neighbour pair, not a contact
     }
-    if (!contacts.exists[c]) contacts.create(c, normal);  // created by proximity
-    const double arm1 = r1 + 0.5 * gap;                   // |x_c − x_1|
-    const Vec3 point = x1 + normal * arm1;                // x_c, centre of the gap/overlap
+    const double dist = std::sqrt(dist2);
+    normal = dist > 0.0 ? d / dist : contacts.normal[c];  // coincident centres: keep the old normal
+    gap = dist - rsum;
+  } else {
+    const auto touch = wall_touch(walls.walls[key.b], x1, r1);
+    if (!touch && !contacts.exists[c]) return true;
+    normal = touch ? touch->normal : contacts.normal[c];
+    gap = touch ? touch->gap : std::numeric_limits<double>::infinity();
+    if (!contacts.exists[c] && gap > proximity) return true;
+  }
+  if (!contacts.exists[c]) contacts.create(c, normal);  // created by proximity
+  const double arm1 = r1 + 0.5 * gap;                   // |x_c − x_1|
+  const Vec3 point = x1 + normal * arm1;                // x_c, centre of the gap/overlap
 
-    // Relative velocity of the material points at x_c (spec §1.2) and the mean spin about n̂_c.
-    const Vec3 v1 = balls.velocity[a] + cross(balls.spin[a], normal * arm1);
-    Vec3 v2, spin2;
-    if (ball2) {
-      spin2 = balls.spin[key.b];
-      v2 = balls.velocity[key.b] - cross(spin2, normal * (rad[key.b] + 0.5 * gap));
-    } else {
-      v2 = wall_point_velocity(walls.walls[key.b], point);
-      spin2 = walls.walls[key.b].spin;
-    }
-    const PlaneRotation rotation(contacts.normal[c], normal, 0.5 * dot(balls.spin[a] + spin2, normal), dt);
-    const ContactKinematics kin{normal, gap, v2 - v1, dt};
+  // Relative velocity of the material points at x_c (spec §1.2) and the mean spin about n̂_c.
+  const Vec3 v1 = balls.velocity[a] + cross(balls.spin[a], normal * arm1);
+  Vec3 v2, spin2;
+  if (ball2) {
+    spin2 = balls.spin[key.b];
+    v2 = balls.velocity[key.b] - cross(spin2, normal * (rad[key.b] + 0.5 * gap));
+  } else {
+    v2 = wall_point_velocity(walls.walls[key.b], point);
+    spin2 = walls.walls[key.b].spin;
+  }
+  const PlaneRotation rotation(contacts.normal[c], normal, 0.5 * dot(balls.spin[a] + spin2, normal), dt);
+  const ContactKinematics kin{normal, gap, v2 - v1, dt};
 
-    Vec3 force, shear;
-    double fn = 0.0, fm = 0.0, trial = 0.0;
-    bool active = false;
-    StiffnessEstimate stiff;
-    if (contacts.model[c] == ModelKind::Hill) {
-      const HillState prev{rotation.carry(contacts.shear_state[c]), contacts.moisture[c]};
-      const HillResult r = hill_force(contacts.hill_params[c], contacts.hill_map[c], kin, prev);
-      contacts.shear_state[c] = r.state.shear_hm;
-      contacts.moisture[c] = r.state.moisture;
-      force = r.force, shear = r.shear_force, fn = r.surface_normal, fm = r.moisture_force;
-      trial = r.trial_shear, active = r.active;
-      if (active && want_stiffness) stiff = hill_timestep_stiffness(contacts.hill_params[c], contacts.hill_map[c], gap);
-    } else {
-      const LinearState prev{rotation.carry(contacts.shear_state[c])};
-      const LinearResult r = linear_force(contacts.linear_params[c], contacts.linear_map[c], kin, prev);
-      contacts.shear_state[c] = r.state.shear_force;
-      force = r.force, shear = r.shear_force, fn = r.normal_force, trial = r.trial_shear, active = r.active;
-      if (active) stiff = {contacts.linear_map[c].kn, contacts.linear_map[c].ks};
-    }
-    // Deleted when inactive beyond the proximity distance (a wet contact stays active: spec §2.5).
-    if (!active && gap > proximity) {
-      contacts.remove(c);
-      contacts.gap[c] = gap;
-      contacts.normal[c] = normal;
-      return true;
-    }
-    // Accumulated shear displacement (reported, not used by the laws): rotated with the plane.
-    contacts.shear_disp[c] = active ? rotation.rotate(contacts.shear_disp[c]) + kin.shear_rate() * dt : Vec3{};
-    contacts.normal[c] = normal;
+  Vec3 force, shear;
+  double fn = 0.0, fm = 0.0, trial = 0.0;
+  bool active = false;
+  StiffnessEstimate stiff;
+  Moisture moisture = contacts.moisture[c];
+  if (contacts.model[c] == ModelKind::Hill) {
+    const HillState prev{rotation.carry(contacts.shear_state[c]), contacts.moisture[c]};
+    const HillResult r = hill_force(contacts.hill_params[c], contacts.hill_map[c], kin, prev);
+    contacts.shear_state[c] = r.state.shear_hm;
+    moisture = r.state.moisture;
+    force = r.force, shear = r.shear_force, fn = r.surface_normal, fm = r.moisture_force;
+    trial = r.trial_shear, active = r.active;
+    if (active && want_stiffness) stiff = hill_timestep_stiffness(contacts.hill_params[c], contacts.hill_map[c], gap);
+  } else {
+    const LinearState prev{rotation.carry(contacts.shear_state[c])};
+    const LinearResult r = linear_force(contacts.linear_params[c], contacts.linear_map[c], kin, prev);
+    contacts.shear_state[c] = r.state.shear_force;
+    force = r.force, shear = r.shear_force, fn = r.normal_force, trial = r.trial_shear, active = r.active;
+    if (active) stiff = {contacts.linear_map[c].kn, contacts.linear_map[c].ks};
+  }
+  // Deleted when inactive beyond the proximity distance (a wet contact stays active: spec §2.5).
+  if (!active && gap > proximity) {
+    contacts.remove(c);  // (moisture back to dry)
     contacts.gap[c] = gap;
-    contacts.force[c] = active ? force : Vec3{};
-    contacts.torque[c] = active ? cross(normal, force) : Vec3{};
-    contacts.normal_force[c] = fn;
-    contacts.moisture_force[c] = fm;
-    contacts.shear_force[c] = shear;
-    contacts.trial_shear[c] = trial;
-    contacts.active[c] = active;
-    contacts.k_tran[c] = stiff.kn + stiff.ks;
-    contacts.k_shear[c] = stiff.ks;
-    return std::isfinite(force.x + force.y + force.z);
+    contacts.normal[c] = normal;
+    return true;
+  }
+  // Accumulated shear displacement (reported, not used by the laws): rotated with the plane.
+  contacts.shear_disp[c] = active ? rotation.rotate(contacts.shear_disp[c]) + kin.shear_rate() * dt : Vec3{};
+  contacts.normal[c] = normal;
+  contacts.gap[c] = gap;
+  contacts.force[c] = active ? force : Vec3{};
+  contacts.torque[c] = active ? cross(normal, force) : Vec3{};
+  contacts.normal_force[c] = fn;
+  contacts.moisture_force[c] = fm;
+  contacts.shear_force[c] = shear;
+  contacts.trial_shear[c] = trial;
+  contacts.k_tran[c] = stiff.kn + stiff.ks;
+  contacts.k_shear[c] = stiff.ks;
+  // Byte-sized columns last: a char store may alias anything, so the compiler reloads every
+  // column pointer after one.
+  contacts.moisture[c] = moisture;
+  contacts.active[c] = active;
+  return std::isfinite(force.x + force.y + force.z);
 }
 
 void Simulation::force_pass(double dt) {
