@@ -1,0 +1,170 @@
+// hilldem triaxial: material genesis and servo-controlled triaxial tests of the memo's Class 5
+// materials, one case or the whole study (docs/lab-tests.md).
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+#include <omp.h>
+
+#include "commands.hpp"
+#include "hilldem/core/error.hpp"
+#include "hilldem/labtests/study.hpp"
+
+namespace hilldem::cli {
+
+namespace {
+
+// Memo vessel: 170 mm x 240 mm. The default specimen is this vessel scaled by kDefaultScale.
+constexpr double kMemoRadius = 0.085, kMemoHeight = 0.240;
+constexpr double kDefaultScale = 0.5;
+
+struct Options {
+  bool study = false;
+  std::string grading = "C5b";
+  std::string material = "hill";
+  bool wet = false;
+  std::string output;
+  bool full = false;
+  double scale = kDefaultScale;
+  std::int64_t seed = 10000;
+  double pressure = 150e3;
+  std::vector<double> cycles{0.02, 0.05};  // [%]
+  double final_strain = 1.0;                // [%]
+  double strain_rate = 0.0;                 // [1/s], 0: default
+  double final_strain_rate = 0.0;
+  double unload_to = 0.1;
+  double suction = 20e3;
+  double moisture_gap = 3e-3;
+  double d_mult = 1.0;
+  double finalize_ratio = 0.0;
+  std::string specimen;
+  bool no_plot = false;
+  int threads = 0;
+  bool quiet = false;
+};
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+// Options -> settings and cases; every check that can fail does so here, before any work.
+std::pair<StudySettings, std::vector<CaseSpec>> build(const Options& o) {
+  StudySettings s;
+  if (o.full && o.scale != kDefaultScale) throw InputError("give either --full or --scale, not both");
+  const double scale = o.full ? 1.0 : o.scale;
+  if (!(scale > 0 && scale <= 4)) throw InputError(fmt::format("--scale must be in (0, 4], got {:g}", scale));
+  s.genesis.vessel_radius = kMemoRadius * scale;
+  s.genesis.vessel_height = kMemoHeight * scale;
+  s.genesis.d_mult = o.d_mult;
+  if (o.seed < 0) throw InputError(fmt::format("--seed must be >= 0, got {}", o.seed));
+  s.genesis.packing.seed = static_cast<std::uint64_t>(o.seed);
+  if (!(o.pressure > 0)) throw InputError(fmt::format("--pressure must be > 0 Pa, got {:g}", o.pressure));
+  s.genesis.packing.equilibrium.pressure = o.pressure;
+  s.finalize = s.genesis.packing.equilibrium;
+  if (o.finalize_ratio > 0) s.finalize.ratio = o.finalize_ratio;
+  s.triaxial.confinement = o.pressure;
+  s.triaxial.cycle_strains.clear();
+  for (double c : o.cycles) s.triaxial.cycle_strains.push_back(c / 100.0);
+  s.triaxial.final_strain = o.final_strain / 100.0;
+  if (o.strain_rate > 0) s.triaxial.strain_rate = o.strain_rate;
+  else if (o.strain_rate < 0) throw InputError(fmt::format("--strain-rate must be > 0 1/s, got {:g}", o.strain_rate));
+  if (o.final_strain_rate > 0) s.triaxial.final_strain_rate = o.final_strain_rate;
+  else if (o.final_strain_rate < 0) throw InputError(fmt::format("--final-strain-rate must be > 0 1/s, got {:g}", o.final_strain_rate));
+  s.triaxial.unload_fraction = o.unload_to;
+  s.suction = o.suction;
+  s.moisture_gap = o.moisture_gap;
+  s.specimen_file = o.specimen;
+  std::vector<CaseSpec> cases;
+  if (o.study) {
+    if (o.wet) throw InputError("--wet and --study: the study already has its wet case");
+    if (!o.specimen.empty()) throw InputError("--specimen and --study: the study packs one specimen per grading");
+    cases = memo_cases();
+    s.output_dir = o.output.empty() ? "out/study" : o.output;
+  } else {
+    const std::string m = lower(o.material);
+    if (m != "hill" && m != "linear") throw InputError("unknown material '" + o.material + "': choose linear or hill");
+    cases.push_back({o.grading, m == "hill" ? GrainModel::Hill : GrainModel::Linear, o.wet});
+    s.output_dir = o.output.empty() ? "out/triaxial" : o.output;
+  }
+  validate(s, cases);
+  return {s, cases};
+}
+
+std::string find_plot_script() {
+  for (const std::string p : {std::string("scripts/plot_triaxial.py"), std::string(HILLDEM_SOURCE_DIR) + "/scripts/plot_triaxial.py"})
+    if (std::filesystem::exists(p)) return p;
+  return "";
+}
+
+std::string quote(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+int run(const Options& o) {
+  auto [settings, cases] = build(o);  // throws InputError (exit 2) before anything is written
+  if (o.threads > 0) omp_set_num_threads(o.threads);
+  std::ostream* log = o.quiet ? nullptr : &std::cout;
+  if (log)
+    *log << fmt::format("hilldem triaxial: {} case{} in a {:.0f} mm x {:.0f} mm vessel{}; output {}\n", cases.size(),
+                        cases.size() > 1 ? "s" : "", 2e3 * settings.genesis.vessel_radius, 1e3 * settings.genesis.vessel_height,
+                        settings.genesis.vessel_radius == kMemoRadius ? " (the memo's)" : " (scaled; --full for the memo's 170 mm x 240 mm)",
+                        settings.output_dir);
+  const StudyResult result = run_study(settings, cases, log);
+  std::cout << "\n" << result.summary_markdown();
+  std::cout << fmt::format("\nsummary: {}/summary.csv, {}/summary.md; {:.0f} s in all\n", settings.output_dir, settings.output_dir,
+                           result.seconds);
+  if (!o.no_plot) {
+    const std::string script = find_plot_script();
+    if (script.empty()) {
+      std::cout << "figures: scripts/plot_triaxial.py not found; skipped\n";
+    } else {
+      const std::string cmd = "python3 " + quote(script) + " " + quote(settings.output_dir);
+      const int rc = std::system(cmd.c_str());
+      if (rc != 0) std::cout << "figures: `" << cmd << "` failed (python3-matplotlib missing?); the CSV results stand\n";
+    }
+  }
+  return 0;
+}
+
+}  // namespace
+
+Command add_triaxial_command(CLI::App& app) {
+  auto o = std::make_shared<Options>();
+  auto* cmd = app.add_subcommand(
+      "triaxial",
+      "Material genesis (grading, boundary-contraction packing, finalization, wetting) and a servo-controlled triaxial "
+      "test with load-unload cycles; --study runs the memo's five Class 5 cases");
+  cmd->add_flag("--study", o->study, "the memo's study: C5n/C5b x linear/hill, plus C5b hill wet, with a summary and figures");
+  cmd->add_option("--grading", o->grading, "C5n, C5b, or a CSV file of d_lower_mm,d_upper_mm,fraction rows (default C5b)");
+  cmd->add_option("--material", o->material, "grain-grain model: linear or hill (default hill)");
+  cmd->add_flag("--wet", o->wet, "make_wet(suction, moisture gap) at the end of genesis (hill only)");
+  cmd->add_option("-o,--output", o->output, "output folder (default out/triaxial, or out/study with --study)");
+  cmd->add_flag("--full", o->full, "the memo's full 170 mm x 240 mm vessel (default: scaled by 0.5, 85 mm x 120 mm)");
+  cmd->add_option("--scale", o->scale, "vessel size relative to the memo's 170 mm x 240 mm (default 0.5)");
+  cmd->add_option("--seed", o->seed, "random seed of the grain cloud (default 10000, Table 7)");
+  cmd->add_option("--pressure", o->pressure, "packing pressure P_m and confinement [Pa] (default 150e3)");
+  cmd->add_option("--cycles", o->cycles, "axial strains [%] at which load-unload cycles reverse, increasing (default 0.02,0.05)")
+      ->delimiter(',');
+  cmd->add_option("--final-strain", o->final_strain, "final axial strain [%] (default 1)");
+  cmd->add_option("--strain-rate", o->strain_rate, "axial strain rate during the cycles [1/s] (default 0.02)");
+  cmd->add_option("--final-strain-rate", o->final_strain_rate, "axial strain rate after the cycles [1/s] (default 0.1)");
+  cmd->add_option("--unload-to", o->unload_to, "unload until q falls to this fraction of q at the reversal (default 0.1)");
+  cmd->add_option("--suction", o->suction, "suction of make_wet [Pa] (default 20e3)");
+  cmd->add_option("--moisture-gap", o->moisture_gap, "moisture gap of make_wet [m] (default 3e-3)");
+  cmd->add_option("--d-mult", o->d_mult, "diameter multiplier D_mult (default 1)");
+  cmd->add_option("--finalize-ratio", o->finalize_ratio, "equilibrium ratio after finalization and wetting (default 8e-3)");
+  cmd->add_option("--specimen", o->specimen, "start from a saved packed specimen (out/.../specimens/<grading>_packed.csv)");
+  cmd->add_flag("--no-plot", o->no_plot, "do not run scripts/plot_triaxial.py");
+  cmd->add_option("--threads", o->threads, "OpenMP threads (0: default)")->check(CLI::Range(0, 1024));
+  cmd->add_flag("-q,--quiet", o->quiet, "only the summary");
+  return {cmd, [o] { return run(*o); }};
+}
+
+}  // namespace hilldem::cli

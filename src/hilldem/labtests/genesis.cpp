@@ -1,0 +1,330 @@
+#include "hilldem/labtests/genesis.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <numbers>
+#include <numeric>
+#include <ostream>
+#include <unordered_map>
+
+#include "hilldem/core/error.hpp"
+#include "hilldem/labtests/measure_region.hpp"
+
+namespace hilldem {
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Grid hash of placed grains for the cloud (cell = largest diameter).
+class PlacementGrid {
+ public:
+  PlacementGrid(double radius, double height, double cell) : cell_(cell) {
+    n_[0] = n_[1] = std::max(1, static_cast<int>(std::ceil(2 * radius / cell)));
+    n_[2] = std::max(1, static_cast<int>(std::ceil(height / cell)));
+    lo_ = Vec3{-radius, -radius, 0.0};
+    cells_.resize(static_cast<std::size_t>(n_[0]) * n_[1] * n_[2]);
+  }
+  void insert(std::size_t i, const Vec3& x) { cells_[index(coords(x))].push_back(static_cast<std::uint32_t>(i)); }
+  // Σ of overlap depths of a grain (x, r) with the placed grains.
+  double overlap(const Vec3& x, double r, const std::vector<Vec3>& pos, const std::vector<double>& rad) const {
+    const auto c = coords(x);
+    double sum = 0.0;
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int q[3] = {c[0] + dx, c[1] + dy, c[2] + dz};
+          if (q[0] < 0 || q[1] < 0 || q[2] < 0 || q[0] >= n_[0] || q[1] >= n_[1] || q[2] >= n_[2]) continue;
+          for (std::uint32_t j : cells_[index({q[0], q[1], q[2]})]) {
+            const double d = norm(pos[j] - x), ov = r + rad[j] - d;
+            if (ov > 0.0) sum += ov;
+          }
+        }
+    return sum;
+  }
+
+ private:
+  std::array<int, 3> coords(const Vec3& x) const {
+    std::array<int, 3> c{};
+    for (int d = 0; d < 3; ++d) c[d] = std::clamp(static_cast<int>((x[d] - lo_[d]) / cell_), 0, n_[d] - 1);
+    return c;
+  }
+  std::size_t index(const std::array<int, 3>& c) const {
+    return (static_cast<std::size_t>(c[2]) * n_[1] + c[1]) * n_[0] + c[0];
+  }
+  double cell_;
+  int n_[3];
+  Vec3 lo_;
+  std::vector<std::vector<std::uint32_t>> cells_;
+};
+
+void check_range(bool ok, const std::string& what, double value, const std::string& range) {
+  if (!ok) throw InputError(fmt::format("{} must be {}, got {:g}", what, range, value));
+}
+
+// Removes the controllers it added when it goes out of scope (also on exceptions).
+struct ControllerScope {
+  Simulation& sim;
+  std::size_t before;
+  explicit ControllerScope(Simulation& s) : sim(s), before(s.controllers.size()) {}
+  ~ControllerScope() { sim.controllers.resize(before); }
+};
+
+}  // namespace
+
+void validate(const GenesisSpec& s) {
+  validate_grading(s.grading);
+  const PackingSettings& p = s.packing;
+  const EquilibriumSettings& e = p.equilibrium;
+  check_range(s.d_mult > 0 && std::isfinite(s.d_mult), "diameter multiplier", s.d_mult, "> 0");
+  check_range(s.vessel_radius > 0 && std::isfinite(s.vessel_radius), "vessel radius [m]", s.vessel_radius, "> 0");
+  check_range(s.vessel_height > 0 && std::isfinite(s.vessel_height), "vessel height [m]", s.vessel_height, "> 0");
+  check_range(p.cloud_porosity > 0 && p.cloud_porosity < 1, "cloud porosity", p.cloud_porosity, "in (0, 1)");
+  check_range(p.local_damping >= 0 && p.local_damping < 1, "local damping", p.local_damping, "in [0, 1)");
+  check_range(e.pressure > 0 && std::isfinite(e.pressure), "pressure [Pa]", e.pressure, "> 0");
+  check_range(e.pressure_tolerance > 0 && e.pressure_tolerance < 1, "pressure tolerance", e.pressure_tolerance, "in (0, 1)");
+  check_range(e.ratio > 0 && e.ratio < 1, "equilibrium ratio", e.ratio, "in (0, 1)");
+  check_range(e.servo_gain > 0 && e.servo_gain <= 1, "servo gain", e.servo_gain, "in (0, 1]");
+  check_range(e.wall_speed_limit > 0 && std::isfinite(e.wall_speed_limit), "wall speed limit [m/s]", e.wall_speed_limit, "> 0");
+  double d_max = 0.0;
+  for (const GradingBin& b : s.grading.bins) d_max = std::max(d_max, b.d_upper * s.d_mult);
+  if (d_max >= std::min(2 * s.vessel_radius, s.vessel_height))
+    throw InputError(fmt::format("the largest grain ({:g} mm) does not fit in the vessel ({:g} mm x {:g} mm)",
+                                 d_max * 1e3, 2e3 * s.vessel_radius, 1e3 * s.vessel_height));
+}
+
+std::string PhaseReport::line() const {
+  return fmt::format("{:<22} {:>8} steps {:>7.1f} s  n {:.4f} (interior {:.4f})  Z {:.3f}  sigma_r {:.2f} kPa  sigma_bottom {:.2f} kPa  "
+                     "sigma_top {:.2f} kPa  ratio {:.2e}",
+                     name, steps, seconds, state.porosity, state.interior_porosity, state.coordination, state.radial_stress / 1e3,
+                     state.bottom_stress / 1e3, state.top_stress / 1e3, state.ratio);
+}
+
+std::vector<double> Specimen::diameters() const {
+  std::vector<double> d(sim.balls.size());
+  for (std::size_t i = 0; i < d.size(); ++i) d[i] = 2.0 * sim.balls.radius[i];
+  return d;
+}
+
+SpecimenState measure(const Specimen& s) {
+  const Simulation& sim = s.sim;
+  SpecimenState st;
+  st.grains = sim.balls.size();
+  double solid = 0.0;
+  for (double r : sim.balls.radius) solid += 4.0 / 3.0 * std::numbers::pi * r * r * r;
+  st.radius = s.vessel.radius(sim);
+  st.height = s.vessel.height(sim);
+  st.porosity = 1.0 - solid / s.vessel.volume(sim);
+  double d_max = 0.0;
+  for (double r : sim.balls.radius) d_max = std::max(d_max, 2.0 * r);
+  const MeasurementCylinder region{st.radius - d_max, s.vessel.bottom_z(sim) + d_max, s.vessel.top_z(sim) - d_max};
+  st.interior_porosity = region.radius > 0.0 && region.z_hi > region.z_lo
+                             ? region_porosity(region, sim.balls.position, sim.balls.radius)
+                             : st.porosity;
+  std::vector<std::uint32_t> per_ball(st.grains, 0);
+  std::size_t touching = 0;
+  for (std::size_t c = 0; c < sim.contacts.size(); ++c) {
+    if (!sim.contacts.exists[c]) continue;
+    const ContactKey& k = sim.contacts.key[c];
+    if (k.kind == ContactKind::BallBall && sim.contacts.model[c] == ModelKind::Hill &&
+        sim.contacts.moisture[c] == Moisture::Wet)
+      ++st.wet_contacts;
+    if (k.kind != ContactKind::BallBall || !sim.contacts.active[c] || sim.contacts.gap[c] >= 0.0) continue;
+    ++touching;
+    ++per_ball[k.a];
+    ++per_ball[k.b];
+  }
+  if (st.grains > 0) st.coordination = 2.0 * static_cast<double>(touching) / static_cast<double>(st.grains);
+  std::size_t n0 = 0, n1 = 0;
+  for (std::uint32_t z : per_ball) n0 += z == 0, n1 += z == 1;
+  if (st.grains > n0 + n1)
+    st.mech_coordination = (2.0 * static_cast<double>(touching) - static_cast<double>(n1)) /
+                           static_cast<double>(st.grains - n0 - n1);
+  st.radial_stress = s.vessel.radial_stress(sim);
+  st.bottom_stress = s.vessel.bottom_stress(sim);
+  st.top_stress = s.vessel.top_stress(sim);
+  st.ratio = sim.mean_unbalanced_ratio();
+  st.timestep = sim.last_dt;
+  return st;
+}
+
+Specimen make_cloud(const GenesisSpec& spec) {
+  validate(spec);
+  const PackingSettings& p = spec.packing;
+  Specimen s;
+  s.grading = spec.grading.name;
+  s.d_mult = spec.d_mult;
+  s.seed = p.seed;
+  s.pressure = p.equilibrium.pressure;
+  Simulation& sim = s.sim;
+  sim.settings.local_damping = p.local_damping;
+  sim.settings.auto_timestep = true;
+  const std::uint64_t grain_bit = sim.groups.bit(kGrainGroup);
+  const std::uint64_t vessel_bit = sim.groups.bit(kVesselGroup);
+  const double R = spec.vessel_radius, H = spec.vessel_height;
+  s.vessel = add_vessel(sim, R, H, vessel_bit);
+
+  Rng rng(p.seed);
+  const double volume = std::numbers::pi * R * R * H;
+  const GrainSample sample = sample_grains(spec.grading, spec.d_mult, (1.0 - p.cloud_porosity) * volume, rng);
+  std::vector<std::size_t> order(sample.diameters.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return sample.diameters[a] > sample.diameters[b]; });
+  const double d_max = order.empty() ? 0.0 : sample.diameters[order.front()];
+  PlacementGrid grid(R, H, std::max(d_max, 1e-9));
+  std::vector<Vec3> pos;
+  std::vector<double> rad;
+  pos.reserve(order.size());
+  rad.reserve(order.size());
+  const Class5Material grain_defaults;  // granite until finalization sets the material
+  for (std::size_t i : order) {
+    const double r = 0.5 * sample.diameters[i];
+    Vec3 best;
+    double best_overlap = std::numeric_limits<double>::infinity();
+    for (int t = 0; t < std::max(1, p.placement_tries); ++t) {
+      const double rho = (R - r) * std::sqrt(rng.uniform());
+      const double phi = 2.0 * std::numbers::pi * rng.uniform();
+      const Vec3 x{rho * std::cos(phi), rho * std::sin(phi), rng.uniform(r, H - r)};
+      const double ov = grid.overlap(x, r, pos, rad);
+      if (ov < best_overlap) best_overlap = ov, best = x;
+      if (ov == 0.0) break;
+    }
+    grid.insert(pos.size(), best);
+    pos.push_back(best);
+    rad.push_back(r);
+    BallInit b;
+    b.id = static_cast<std::int64_t>(pos.size());
+    b.position = best;
+    b.radius = r;
+    b.density = grain_defaults.density;
+    b.young_mod = grain_defaults.young_mod;
+    b.pois_ratio = grain_defaults.pois_ratio;
+    b.groups = grain_bit;
+    sim.balls.add(b);
+  }
+  sim.sort_balls_spatially();
+  install_table(sim, packing_table(sim, p.contact, p.walls));
+  return s;
+}
+
+PhaseReport relax_cloud(Specimen& s, const PackingSettings& p, std::ostream* log) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Simulation& sim = s.sim;
+  s.vessel.stop(sim);
+  double d_min = std::numeric_limits<double>::infinity();
+  for (double r : sim.balls.radius) d_min = std::min(d_min, 2.0 * r);
+  const double cap = p.cloud_speed_limit;
+  ControllerScope scope(sim);
+  sim.controllers.push_back([cap](Simulation& m, double) {
+    for (Vec3& v : m.balls.velocity) {
+      const double speed = norm(v);
+      if (speed > cap) v *= cap / speed;
+    }
+  });
+  const std::int64_t start = sim.steps;
+  auto worst_overlap = [&] {
+    double worst = 0.0;
+    for (std::size_t c = 0; c < sim.contacts.size(); ++c)
+      if (sim.contacts.exists[c] && sim.contacts.active[c]) worst = std::max(worst, -sim.contacts.gap[c]);
+    return worst;
+  };
+  sim.update_forces();
+  while (worst_overlap() > p.cloud_overlap * d_min) {
+    if (sim.steps - start >= p.cloud_max_steps) {
+      if (log)
+        *log << fmt::format("cloud: overlaps not below {:g} x D_min after {} steps (worst {:.3g} mm); packing anyway\n",
+                            p.cloud_overlap, p.cloud_max_steps, worst_overlap() * 1e3);
+      break;
+    }
+    sim.cycle(50);
+  }
+  for (Vec3& v : sim.balls.velocity) v = Vec3{};
+  for (Vec3& w : sim.balls.spin) w = Vec3{};
+  PhaseReport r{"cloud", sim.steps - start, seconds_since(t0), measure(s)};
+  if (log) *log << r.line() << "\n";
+  s.phases.push_back(r);
+  return r;
+}
+
+PhaseReport servo_equilibrium(Specimen& s, const EquilibriumSettings& e, const std::string& name, std::ostream* log) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Simulation& sim = s.sim;
+  const ServoSettings ss{e.pressure, e.servo_gain, e.wall_speed_limit};
+  auto servos = std::make_shared<std::vector<Servo>>(
+      std::vector<Servo>{s.vessel.radial_servo(ss), s.vessel.platen_servo(false, ss), s.vessel.platen_servo(true, ss)});
+  ControllerScope scope(sim);
+  sim.controllers.push_back([servos](Simulation& m, double dt) {
+    for (Servo& sv : *servos) sv.control(m, dt);
+  });
+  const std::int64_t start = sim.steps;
+  const std::int64_t progress_every = 20000;
+  std::int64_t next_progress = start + progress_every;
+  auto within = [&](double stress) { return std::abs(stress - e.pressure) <= e.pressure_tolerance * e.pressure; };
+  for (;;) {
+    sim.cycle(std::max<std::int64_t>(1, e.check_every));
+    const double sr = s.vessel.radial_stress(sim), sb = s.vessel.bottom_stress(sim), st = s.vessel.top_stress(sim);
+    if (within(sr) && within(sb) && within(st) && sim.mean_unbalanced_ratio() <= e.ratio) break;
+    if (log && sim.steps >= next_progress) {
+      next_progress += progress_every;
+      *log << fmt::format("  {} step {:>8}: n {:.4f}  sigma_r {:.1f}  sigma_b {:.1f}  sigma_t {:.1f} kPa  ratio {:.2e}  dt {:.3g} s\n",
+                          name, sim.steps - start, measure(s).porosity, sr / 1e3, sb / 1e3, st / 1e3,
+                          sim.mean_unbalanced_ratio(), sim.last_dt);
+      log->flush();
+    }
+    if (sim.steps - start >= e.max_steps) {
+      s.vessel.stop(sim);
+      throw RunError(fmt::format("{}: wall pressures not within {:g} % of {:g} kPa with ratio <= {:g} after {} steps "
+                                 "(sigma_r {:.2f}, sigma_bottom {:.2f}, sigma_top {:.2f} kPa, ratio {:.3g})",
+                                 name, 100 * e.pressure_tolerance, e.pressure / 1e3, e.ratio, e.max_steps, sr / 1e3,
+                                 sb / 1e3, st / 1e3, sim.mean_unbalanced_ratio()));
+    }
+  }
+  s.vessel.stop(sim);
+  PhaseReport r{name, sim.steps - start, seconds_since(t0), measure(s)};
+  if (log) *log << r.line() << "\n";
+  s.phases.push_back(r);
+  return r;
+}
+
+Specimen pack_specimen(const GenesisSpec& spec, std::ostream* log) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Specimen s = make_cloud(spec);
+  if (log)
+    *log << fmt::format("cloud: {} grains of {} at porosity {:.3f} in a {:.0f} mm x {:.0f} mm vessel (seed {}, {:.1f} s)\n",
+                        s.sim.balls.size(), spec.grading.name, measure(s).porosity, 2e3 * spec.vessel_radius,
+                        1e3 * spec.vessel_height, spec.packing.seed, seconds_since(t0));
+  relax_cloud(s, spec.packing, log);
+  servo_equilibrium(s, spec.packing.equilibrium, "packing", log);
+  return s;
+}
+
+PhaseReport finalize(Specimen& s, const Class5Material& m, const WallContact& walls, const EquilibriumSettings& e,
+                     std::ostream* log) {
+  apply_grain_properties(s.sim, m);
+  install_table(s.sim, material_table(s.sim, m, walls));
+  s.material = m.name(s.grading);
+  s.wet = false;
+  return servo_equilibrium(s, e, "finalize " + s.material, log);
+}
+
+PhaseReport make_specimen_wet(Specimen& s, double suction, double gap, const EquilibriumSettings& e, std::ostream* log) {
+  if (!(suction >= 0) || !std::isfinite(suction)) throw InputError(fmt::format("suction must be >= 0 Pa, got {:g}", suction));
+  if (!(gap >= 0) || !std::isfinite(gap)) throw InputError(fmt::format("moisture gap must be >= 0 m, got {:g}", gap));
+  bool hill = false;
+  for (const ModelRule& r : s.sim.table.rules) hill = hill || (r.kind == ContactKind::BallBall && r.model == ModelKind::Hill);
+  if (!hill) throw InputError("only a hill material can be made wet (the linear model has no liquid bridges)");
+  const std::size_t wet = s.sim.make_wet(suction, gap);
+  s.wet = true;
+  if (log) *log << fmt::format("make_wet({:g} kPa, {:g} mm): {} wet contacts\n", suction / 1e3, gap * 1e3, wet);
+  return servo_equilibrium(s, e, "wet " + s.material, log);
+}
+
+}  // namespace hilldem

@@ -1,0 +1,112 @@
+// Material genesis (docs/spec/lab-tests.md §3): a seeded random cloud of grains at porosity n_c in
+// the vessel, frictionless packing by boundary contraction under servo control to the material
+// pressure P_m, static equilibrium, finalization through the assignment table, and (optionally)
+// wetting. Every phase reports what it did and the state it reached.
+#pragma once
+
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include "hilldem/engine/simulation.hpp"
+#include "hilldem/labtests/gsd.hpp"
+#include "hilldem/labtests/material.hpp"
+#include "hilldem/labtests/vessel.hpp"
+
+namespace hilldem {
+
+// Servo-controlled equilibrium of the three vessel walls at one pressure.
+struct EquilibriumSettings {
+  double pressure = 150e3;           // target wall pressure [Pa] (P_m)
+  double pressure_tolerance = 1e-2;  // ε_P: every wall within ε_P·P of P [-]
+  double ratio = 8e-3;               // static equilibrium: mean unbalanced-force ratio ≤ this [-]
+  double servo_gain = 0.5;           // α_s [-]
+  double wall_speed_limit = 1.0;     // v_lim [m/s]
+  std::int64_t check_every = 50;     // cycles between convergence checks
+  std::int64_t max_steps = 4'000'000;
+};
+
+struct PackingSettings {
+  std::uint64_t seed = 10000;        // N_RS (Table 7)
+  double cloud_porosity = 0.58;      // n_c (Table 7)
+  double local_damping = 0.7;        // α (Table 7)
+  int placement_tries = 20;          // cloud: best of this many random positions per grain [ours]
+  double cloud_speed_limit = 1.0;    // cloud relaxation: grain speed cap [m/s] [ours]
+  double cloud_overlap = 1e-3;       // relaxation ends when every overlap ≤ this × smallest diameter [ours]
+  std::int64_t cloud_max_steps = 200'000;
+  EquilibriumSettings equilibrium;   // P_m = 150 kPa, ε_P = 1e-2, ε_lim = 8e-3, v_lim = 1 m/s (Table 7)
+  PackingContact contact;            // frictionless linear packing contacts
+  WallContact walls;
+};
+
+struct GenesisSpec {
+  Grading grading = grading_c5b();
+  double d_mult = 1.0;               // D_mult (Table 7)
+  double vessel_radius = 0.085;      // [m] (170 mm diameter)
+  double vessel_height = 0.240;      // [m]
+  PackingSettings packing;
+};
+// Throws InputError naming the first bad value.
+void validate(const GenesisSpec& spec);
+
+// What a specimen looks like now.
+struct SpecimenState {
+  std::size_t grains = 0;
+  double porosity = 0.0;            // 1 − V_solid / (π R² H) [-]: the whole vessel
+  double interior_porosity = 0.0;   // in the coaxial cylinder one D_max in from every wall [-] (measure_region.hpp)
+  double coordination = 0.0;        // 2 N_c / N_grains, touching grain-grain contacts [-]
+  double mech_coordination = 0.0;   // Thornton's: grains with < 2 contacts left out [-]
+  double radial_stress = 0.0;       // lateral wall [Pa]
+  double bottom_stress = 0.0, top_stress = 0.0;  // platens [Pa]
+  double radius = 0.0, height = 0.0;             // vessel [m]
+  double ratio = 0.0;               // mean unbalanced-force ratio [-]
+  std::size_t wet_contacts = 0;
+  double timestep = 0.0;            // Δt of the last cycle [s]
+};
+
+struct PhaseReport {
+  std::string name;          // "cloud", "packing", "finalize C5b_Hill", "wet"
+  std::int64_t steps = 0;    // cycles
+  double seconds = 0.0;      // wall-clock
+  SpecimenState state;       // at the end
+  std::string line() const;  // one console line
+};
+
+struct Specimen {
+  Simulation sim;
+  Vessel vessel;
+  std::string grading = "C5b";
+  double d_mult = 1.0;
+  std::uint64_t seed = 0;
+  double pressure = 0.0;               // P_m it was packed to [Pa]
+  std::string material = "packed";     // what the assignment table holds: "packed", "C5b_Hill", ...
+  bool wet = false;
+  std::vector<PhaseReport> phases;     // genesis history
+  std::vector<double> diameters() const;
+};
+
+SpecimenState measure(const Specimen& s);
+
+// The cloud: grains sampled from the grading for porosity n_c in the vessel and placed at random
+// (best of placement_tries positions, largest grains first; overlaps allowed), packing table
+// installed, no gravity, local damping α.
+Specimen make_cloud(const GenesisSpec& spec);
+// Cycles with the walls at rest and grain speeds capped until the cloud's overlaps are gone, then
+// sets every velocity to zero.
+PhaseReport relax_cloud(Specimen& s, const PackingSettings& p, std::ostream* log);
+// Servo-controlled walls to P ± ε_P·P and mean unbalanced-force ratio ≤ ε_lim; walls stopped at the
+// end. Throws RunError after max_steps.
+PhaseReport servo_equilibrium(Specimen& s, const EquilibriumSettings& e, const std::string& name, std::ostream* log);
+// make_cloud + relax_cloud + servo_equilibrium: the packed (frictionless) specimen.
+Specimen pack_specimen(const GenesisSpec& spec, std::ostream* log);
+
+// Finalization: grain properties and the material's assignment table installed on every contact,
+// then servo equilibrium at the specimen's P_m.
+PhaseReport finalize(Specimen& s, const Class5Material& m, const WallContact& walls, const EquilibriumSettings& e,
+                     std::ostream* log);
+// Wet material (lab-tests.md §3.6): make_wet(ψ, g_m) on the finalized hill specimen, then servo
+// equilibrium. Throws InputError for a linear material (no liquid bridges).
+PhaseReport make_specimen_wet(Specimen& s, double suction, double gap, const EquilibriumSettings& e, std::ostream* log);
+
+}  // namespace hilldem

@@ -1,0 +1,77 @@
+#include "hilldem/labtests/material.hpp"
+
+namespace hilldem {
+
+const char* to_string(GrainModel m) { return m == GrainModel::Hill ? "hill" : "linear"; }
+
+std::string Class5Material::name(const std::string& grading) const {
+  return grading + (model == GrainModel::Hill ? "_Hill" : "_Linear");
+}
+
+namespace {
+ModelRule wall_rule(Simulation& sim, const WallContact& walls) {
+  ModelRule r;
+  r.name = "grain-vessel";
+  r.kind = ContactKind::BallWall;
+  r.groups1 = sim.groups.bit(kGrainGroup);
+  r.groups2 = sim.groups.bit(kVesselGroup);
+  r.groups1_text = kGrainGroup;
+  r.groups2_text = kVesselGroup;
+  r.model = ModelKind::Linear;
+  r.linear = LinearParams{walls.emod, walls.kratio, walls.fric};
+  return r;
+}
+ModelRule grain_rule(Simulation& sim, const std::string& name) {
+  ModelRule r;
+  r.name = name;
+  r.kind = ContactKind::BallBall;
+  r.groups1 = r.groups2 = sim.groups.bit(kGrainGroup);
+  r.groups1_text = r.groups2_text = kGrainGroup;
+  return r;
+}
+}  // namespace
+
+ModelTable packing_table(Simulation& sim, const PackingContact& grains, const WallContact& walls) {
+  ModelTable t;
+  ModelRule g = grain_rule(sim, "grain-grain packing");
+  g.model = ModelKind::Linear;
+  g.linear = LinearParams{grains.emod, grains.kratio, grains.fric};
+  t.rules.push_back(g);
+  WallContact w = walls;
+  w.fric = 0.0;  // frictionless walls during genesis [practice]
+  t.rules.push_back(wall_rule(sim, w));
+  return t;
+}
+
+ModelTable material_table(Simulation& sim, const Class5Material& m, const WallContact& walls) {
+  ModelTable t;
+  ModelRule g = grain_rule(sim, m.model == GrainModel::Hill ? "grain-grain hill" : "grain-grain linear");
+  if (m.model == GrainModel::Hill) {
+    g.model = ModelKind::Hill;
+    g.hill = HillParams{m.fric, m.damp_con, m.suction};
+  } else {
+    g.model = ModelKind::Linear;
+    g.linear = LinearParams{m.linear_emod, m.linear_kratio, m.fric};
+  }
+  t.rules.push_back(g);
+  t.rules.push_back(wall_rule(sim, walls));
+  return t;
+}
+
+void install_table(Simulation& sim, ModelTable table) {
+  sim.table = std::move(table);
+  sim.contacts.clear();
+  sim.invalidate_forces();
+}
+
+void apply_grain_properties(Simulation& sim, const Class5Material& m) {
+  for (std::size_t i = 0; i < sim.balls.size(); ++i) {
+    sim.balls.density[i] = m.density;
+    sim.balls.young_mod[i] = m.young_mod;
+    sim.balls.pois_ratio[i] = m.pois_ratio;
+    sim.balls.update_mass(i);
+  }
+  sim.refresh_mappings();
+}
+
+}  // namespace hilldem

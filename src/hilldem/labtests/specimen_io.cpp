@@ -1,0 +1,188 @@
+#include "hilldem/labtests/specimen_io.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "hilldem/core/error.hpp"
+
+namespace hilldem {
+
+namespace {
+constexpr const char* kMagic = "hilldem-specimen";
+constexpr int kVersion = 1;
+
+std::string trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t\r");
+  if (b == std::string::npos) return "";
+  const auto e = s.find_last_not_of(" \t\r");
+  return s.substr(b, e - b + 1);
+}
+}  // namespace
+
+std::string packed_specimen_text(const Specimen& s, const PackingSettings& p) {
+  if (s.material != "packed" || s.wet)
+    throw InputError("only a packed specimen (before finalization) can be saved: its state is exact without contact history");
+  const Simulation& sim = s.sim;
+  std::string out;
+  out += "# hilldem packed specimen: frictionless packing by boundary contraction; positions and radii\n";
+  out += "# reproduce every contact force of the packing contacts. `hilldem triaxial --specimen FILE` starts here.\n";
+  out += fmt::format("format,{},{}\n", kMagic, kVersion);
+  out += fmt::format("grading,{}\n", s.grading);
+  out += fmt::format("d_mult,{}\n", s.d_mult);
+  out += fmt::format("seed,{}\n", s.seed);
+  out += fmt::format("pressure[Pa],{}\n", s.pressure);
+  out += fmt::format("local_damping,{}\n", sim.settings.local_damping);
+  out += fmt::format("vessel_radius[m],{}\n", s.vessel.radius(sim));
+  out += fmt::format("vessel_bottom[m],{}\n", s.vessel.bottom_z(sim));
+  out += fmt::format("vessel_top[m],{}\n", s.vessel.top_z(sim));
+  out += fmt::format("packing_emod[Pa],{}\n", p.contact.emod);
+  out += fmt::format("packing_kratio,{}\n", p.contact.kratio);
+  out += fmt::format("packing_fric,{}\n", p.contact.fric);
+  out += fmt::format("wall_emod[Pa],{}\n", p.walls.emod);
+  out += fmt::format("wall_kratio,{}\n", p.walls.kratio);
+  out += fmt::format("grains,{}\n", sim.balls.size());
+  out += "id,x[m],y[m],z[m],radius[m],density[kg/m3],young_mod[Pa],pois_ratio[-]\n";
+  for (std::size_t i = 0; i < sim.balls.size(); ++i) {
+    const Vec3& x = sim.balls.position[i];
+    out += fmt::format("{},{},{},{},{},{},{},{}\n", sim.balls.id[i], x.x, x.y, x.z,
+                       sim.balls.radius[i], sim.balls.density[i], sim.balls.young_mod[i], sim.balls.pois_ratio[i]);
+  }
+  return out;
+}
+
+void save_packed_specimen(const Specimen& s, const PackingSettings& p, const std::string& path) {
+  const std::string text = packed_specimen_text(s, p);
+  const auto parent = std::filesystem::path(path).parent_path();
+  if (!parent.empty()) std::filesystem::create_directories(parent);
+  std::ofstream f(path, std::ios::binary);
+  f << text;
+  if (!f) throw RunError(path + ": cannot write the specimen");
+}
+
+Specimen parse_packed_specimen(const std::string& text, const std::string& source, PackingSettings* p_out) {
+  std::istringstream in(text);
+  std::string line;
+  int lineno = 0;
+  std::map<std::string, std::pair<std::string, int>> keys;
+  auto fail = [&](int at, const std::string& what) { return InputError(fmt::format("{}:{}: {}", source, at, what)); };
+  bool header = false;
+  struct Row {
+    std::int64_t id;
+    double v[7];
+    int line;
+  };
+  std::vector<Row> rows;
+  while (std::getline(in, line)) {
+    ++lineno;
+    line = trim(line);
+    if (line.empty() || line[0] == '#') continue;
+    std::vector<std::string> cells;
+    std::stringstream ss(line);
+    std::string c;
+    while (std::getline(ss, c, ',')) cells.push_back(trim(c));
+    if (!header) {
+      if (cells.size() >= 1 && cells[0] == "id") {
+        header = true;
+        if (cells.size() != 8) throw fail(lineno, "expected the header id,x[m],y[m],z[m],radius[m],density[kg/m3],young_mod[Pa],pois_ratio[-]");
+        continue;
+      }
+      if (cells.size() < 2) throw fail(lineno, "expected `key,value`, got '" + line + "'");
+      if (keys.count(cells[0])) throw fail(lineno, "duplicate key '" + cells[0] + "'");
+      keys[cells[0]] = {cells.size() == 3 && cells[0] == "format" ? cells[1] + "," + cells[2] : cells[1], lineno};
+      continue;
+    }
+    if (cells.size() != 8) throw fail(lineno, fmt::format("expected 8 values, got {}", cells.size()));
+    Row r{};
+    r.line = lineno;
+    char* end = nullptr;
+    r.id = std::strtoll(cells[0].c_str(), &end, 10);
+    if (cells[0].empty() || *end != '\0' || r.id < 0) throw fail(lineno, "bad ball id '" + cells[0] + "'");
+    for (int k = 0; k < 7; ++k) {
+      r.v[k] = std::strtod(cells[k + 1].c_str(), &end);
+      if (cells[k + 1].empty() || *end != '\0' || !std::isfinite(r.v[k])) throw fail(lineno, "bad number '" + cells[k + 1] + "'");
+    }
+    if (r.v[3] <= 0 || r.v[4] <= 0) throw fail(lineno, "radius and density must be > 0");
+    rows.push_back(r);
+  }
+  auto get = [&](const std::string& k) -> std::pair<std::string, int> {
+    auto it = keys.find(k);
+    if (it == keys.end()) throw InputError(fmt::format("{}: missing key '{}' (not a hilldem specimen file?)", source, k));
+    return it->second;
+  };
+  auto number = [&](const std::string& k, bool positive) {
+    const auto [v, at] = get(k);
+    char* end = nullptr;
+    const double x = std::strtod(v.c_str(), &end);
+    if (v.empty() || *end != '\0' || !std::isfinite(x) || (positive && x <= 0) || x < 0)
+      throw fail(at, fmt::format("{} must be a number {}, got '{}'", k, positive ? "> 0" : ">= 0", v));
+    return x;
+  };
+  if (get("format").first != fmt::format("{},{}", kMagic, kVersion))
+    throw fail(get("format").second, fmt::format("unsupported format '{}' (expected {},{})", get("format").first, kMagic, kVersion));
+  if (!header) throw InputError(source + ": no grain table (header id,x[m],...)");
+  const double count = number("grains", false);
+  if (static_cast<double>(rows.size()) != count)
+    throw InputError(fmt::format("{}: {} grain rows but grains = {:g}", source, rows.size(), count));
+
+  Specimen s;
+  s.grading = get("grading").first;
+  s.d_mult = number("d_mult", true);
+  s.seed = static_cast<std::uint64_t>(number("seed", false));
+  s.pressure = number("pressure[Pa]", true);
+  PackingSettings p;
+  p.contact.emod = number("packing_emod[Pa]", true);
+  p.contact.kratio = number("packing_kratio", true);
+  p.contact.fric = number("packing_fric", false);
+  p.walls.emod = number("wall_emod[Pa]", true);
+  p.walls.kratio = number("wall_kratio", true);
+  Simulation& sim = s.sim;
+  sim.settings.local_damping = number("local_damping", false);
+  if (sim.settings.local_damping >= 1) throw fail(get("local_damping").second, "local_damping must be below 1");
+  const double radius = number("vessel_radius[m]", true);
+  const double bottom = std::strtod(get("vessel_bottom[m]").first.c_str(), nullptr);
+  const double top = std::strtod(get("vessel_top[m]").first.c_str(), nullptr);
+  if (!(top > bottom)) throw fail(get("vessel_top[m]").second, "vessel_top must be above vessel_bottom");
+  const std::uint64_t grain_bit = sim.groups.bit(kGrainGroup);
+  s.vessel = add_vessel(sim, radius, top - bottom, sim.groups.bit(kVesselGroup));
+  sim.walls.walls[s.vessel.bottom].point.z = sim.walls.walls[s.vessel.bottom].rotation_center.z = bottom;
+  sim.walls.walls[s.vessel.top].point.z = sim.walls.walls[s.vessel.top].rotation_center.z = top;
+  for (const Row& r : rows) {
+    if (sim.balls.find(r.id) >= 0) throw fail(r.line, fmt::format("duplicate ball id {}", r.id));
+    const Vec3 x{r.v[0], r.v[1], r.v[2]};
+    if (std::hypot(x.x, x.y) > radius || x.z < bottom || x.z > top)
+      throw fail(r.line, fmt::format("ball {} lies outside the vessel", r.id));
+    BallInit b;
+    b.id = r.id;
+    b.position = x;
+    b.radius = r.v[3];
+    b.density = r.v[4];
+    b.young_mod = r.v[5];
+    b.pois_ratio = r.v[6];
+    b.groups = grain_bit;
+    sim.balls.add(b);
+  }
+  sim.sort_balls_spatially();
+  install_table(sim, packing_table(sim, p.contact, p.walls));
+  sim.update_forces();
+  if (p_out) {
+    p_out->contact = p.contact;
+    p_out->walls.emod = p.walls.emod;
+    p_out->walls.kratio = p.walls.kratio;
+  }
+  return s;
+}
+
+Specimen load_packed_specimen(const std::string& path, PackingSettings* p) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw InputError(path + ": cannot open the specimen file");
+  std::stringstream buf;
+  buf << f.rdbuf();
+  return parse_packed_specimen(buf.str(), path, p);
+}
+
+}  // namespace hilldem

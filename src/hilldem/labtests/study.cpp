@@ -1,0 +1,333 @@
+#include "hilldem/labtests/study.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <ostream>
+
+#include "hilldem/core/error.hpp"
+#include "hilldem/labtests/specimen_io.hpp"
+
+namespace hilldem {
+
+namespace fs = std::filesystem;
+
+std::string CaseSpec::name() const {
+  std::string g = grading;
+  const std::string low = [&] {
+    std::string s = grading;
+    for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return s;
+  }();
+  if (low == "c5n") g = "C5n";
+  else if (low == "c5b") g = "C5b";
+  else g = fs::path(grading).stem().string();
+  return g + (model == GrainModel::Hill ? "_Hill" : "_Linear") + (wet ? "_wet" : "");
+}
+
+std::vector<CaseSpec> memo_cases() {
+  return {{"C5n", GrainModel::Linear, false},
+          {"C5n", GrainModel::Hill, false},
+          {"C5b", GrainModel::Linear, false},
+          {"C5b", GrainModel::Hill, false},
+          {"C5b", GrainModel::Hill, true}};
+}
+
+void validate(const StudySettings& s, const std::vector<CaseSpec>& cases) {
+  if (cases.empty()) throw InputError("no cases to run");
+  validate(s.triaxial);
+  for (const CaseSpec& c : cases) {
+    GenesisSpec g = s.genesis;
+    g.grading = resolve_grading(c.grading);
+    validate(g);
+    if (c.wet && c.model != GrainModel::Hill)
+      throw InputError("--wet needs the hill material: the linear model has no liquid bridges");
+  }
+  const EquilibriumSettings& e = s.finalize;
+  if (!(e.pressure > 0) || !std::isfinite(e.pressure)) throw InputError(fmt::format("pressure must be > 0 Pa, got {:g}", e.pressure));
+  if (!(e.ratio > 0 && e.ratio < 1)) throw InputError(fmt::format("equilibrium ratio must be in (0, 1), got {:g}", e.ratio));
+  if (!(s.suction >= 0) || !std::isfinite(s.suction)) throw InputError(fmt::format("suction must be >= 0 Pa, got {:g}", s.suction));
+  if (!(s.moisture_gap >= 0) || !std::isfinite(s.moisture_gap))
+    throw InputError(fmt::format("moisture gap must be >= 0 m, got {:g}", s.moisture_gap));
+  const Class5Material& m = s.material;
+  if (!(m.fric >= 0) || !(m.young_mod > 0) || !(m.pois_ratio > -1 && m.pois_ratio <= 0.5) || !(m.linear_emod > 0) ||
+      !(m.linear_kratio > 0) || !(m.damp_con >= 0 && m.damp_con < 1) || !(m.density > 0))
+    throw InputError("material properties out of range");
+  if (!s.specimen_file.empty()) {
+    load_packed_specimen(s.specimen_file);  // parse it now: a bad file stops before any work
+    for (const CaseSpec& c : cases)
+      if (c.grading != cases.front().grading)
+        throw InputError("--specimen gives one packed specimen: all cases must use its grading");
+  }
+}
+
+namespace {
+
+void write_file(const fs::path& p, const std::string& text) {
+  fs::create_directories(p.parent_path());
+  std::ofstream f(p, std::ios::binary);
+  f << text;
+  if (!f) throw RunError(p.string() + ": cannot write");
+}
+
+std::string state_text(const char* label, const SpecimenState& s) {
+  return fmt::format("{}: grains {}, porosity {:.4f} (interior {:.4f}), coordination {:.3f} (mechanical {:.3f}), sigma_r {:.2f} kPa, "
+                     "sigma_bottom {:.2f} kPa, sigma_top {:.2f} kPa, R {:.3f} mm, H {:.3f} mm, wet contacts {}, ratio {:.2e}\n",
+                     label, s.grains, s.porosity, s.interior_porosity, s.coordination, s.mech_coordination, s.radial_stress / 1e3,
+                     s.bottom_stress / 1e3, s.top_stress / 1e3, s.radius * 1e3, s.height * 1e3, s.wet_contacts, s.ratio);
+}
+
+std::string loops_csv(const std::vector<LoopResult>& loops) {
+  std::string out =
+      "cycle,target_strain[-],eps_A[-],q_A[Pa],eps_B[-],q_B[Pa],q_C[Pa],closed,resilient_modulus_unload_secant[Pa],"
+      "reload_secant[Pa],loop_area[J/m3],damping_ratio[-]\n";
+  for (const LoopResult& l : loops)
+    out += fmt::format("{},{:.6g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{},{:.9g},{:.9g},{:.9g},{:.6g}\n", l.cycle, l.target_strain,
+                       l.eps_a, l.q_a, l.eps_b, l.q_b, l.q_c, l.closed ? 1 : 0, l.unload_secant, l.reload_secant, l.loop_area,
+                       l.damping_ratio);
+  return out;
+}
+
+std::size_t max_loops(const std::vector<CaseResult>& cases) {
+  std::size_t n = 0;
+  for (const CaseResult& c : cases) n = std::max(n, c.test.loops.size());
+  return n;
+}
+
+}  // namespace
+
+std::string StudyResult::summary_csv() const {
+  const std::size_t nl = max_loops(cases);
+  std::string out =
+      "case,grading,material,wet,grains,porosity_packed[-],interior_porosity_packed[-],porosity_test_start[-],"
+      "interior_porosity_test_start[-],coordination_test_start[-],"
+      "sigma_r_start[Pa],sigma_axial_start[Pa],peak_q[Pa],peak_eps_a[-]";
+  for (std::size_t k = 1; k <= nl; ++k)
+    out += fmt::format(",eps_A_cycle{0}[-],Mr_unload_secant_cycle{0}[Pa],reload_secant_cycle{0}[Pa],loop_area_cycle{0}[J/m3],"
+                       "damping_ratio_cycle{0}[-]",
+                       k);
+  out += ",worst_confinement_error[-],worst_platen_mismatch[-],test_steps,seconds\n";
+  for (const CaseResult& c : cases) {
+    out += fmt::format("{},{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.9g},{:.9g},{:.9g},{:.6g}", c.spec.name(),
+                       c.grading.name, to_string(c.spec.model), c.spec.wet ? 1 : 0, c.initial.grains, c.packed.porosity,
+                       c.packed.interior_porosity, c.initial.porosity, c.initial.interior_porosity, c.initial.coordination, c.initial.radial_stress,
+                       0.5 * (c.initial.bottom_stress + c.initial.top_stress), c.test.peak_q, c.test.peak_strain);
+    for (std::size_t k = 0; k < nl; ++k) {
+      if (k < c.test.loops.size()) {
+        const LoopResult& l = c.test.loops[k];
+        out += fmt::format(",{:.6g},{:.9g},{},{:.9g},{}", l.eps_a, l.unload_secant, l.closed ? fmt::format("{:.9g}", l.reload_secant) : "",
+                           l.loop_area, l.closed ? fmt::format("{:.6g}", l.damping_ratio) : "");
+      } else {
+        out += ",,,,,";
+      }
+    }
+    out += fmt::format(",{:.6g},{:.6g},{},{:.1f}\n", c.test.worst_confinement_error, c.test.worst_platen_mismatch, c.test.steps,
+                       c.seconds);
+  }
+  return out;
+}
+
+std::string StudyResult::summary_markdown() const {
+  const std::size_t nl = max_loops(cases);
+  std::string head = "| case | grains | porosity packed: vessel / interior | at test start: vessel / interior | Z | peak q [kPa] | at eps_a [%] |";
+  std::string rule = "|---|---:|---:|---:|---:|---:|---:|";
+  for (std::size_t k = 1; k <= nl; ++k) {
+    head += fmt::format(" M_r c{0} [MPa] | reload c{0} [MPa] | loop c{0} [J/m³] |", k);
+    rule += "---:|---:|---:|";
+  }
+  head += " worst sigma_r error [%] | worst platen mismatch [%] | time [s] |";
+  rule += "---:|---:|---:|";
+  std::string out = head + "\n" + rule + "\n";
+  for (const CaseResult& c : cases) {
+    out += fmt::format("| {} | {} | {:.4f} / {:.4f} | {:.4f} / {:.4f} | {:.2f} | {:.1f} | {:.3f} |", c.spec.name(), c.initial.grains,
+                       c.packed.porosity, c.packed.interior_porosity, c.initial.porosity, c.initial.interior_porosity,
+                       c.initial.coordination, c.test.peak_q / 1e3, 100 * c.test.peak_strain);
+    for (std::size_t k = 0; k < nl; ++k) {
+      if (k < c.test.loops.size()) {
+        const LoopResult& l = c.test.loops[k];
+        out += fmt::format(" {:.1f} | {} | {:.3g} |", l.unload_secant / 1e6,
+                           l.closed ? fmt::format("{:.1f}", l.reload_secant / 1e6) : std::string("n/a"), l.loop_area);
+      } else {
+        out += " | | |";
+      }
+    }
+    out += fmt::format(" {:.2f} | {:.2f} | {:.0f} |\n", 100 * c.test.worst_confinement_error, 100 * c.test.worst_platen_mismatch,
+                       c.seconds);
+  }
+  out += "\nM_r: resilient modulus, unload secant (q_A − q_B)/(eps_A − eps_B); reload: reload secant (q_C − q_B)/(eps_A − eps_B);\n"
+         "loop: hysteresis, loop area ∮ q d(eps_a) = energy dissipated per unit volume. Z: touching grain-grain contacts per grain.\n"
+         "Porosity: vessel = 1 − V_grains/(π R² H); interior = in the coaxial cylinder one D_max in from every wall.\n";
+  const auto f = findings();
+  if (!f.empty()) {
+    out += "\nFindings of the memo, checked:\n\n";
+    for (const std::string& s : f) out += "* " + s + "\n";
+  }
+  return out;
+}
+
+std::vector<std::string> StudyResult::findings() const {
+  std::vector<std::string> out;
+  auto find = [&](const std::string& grading, GrainModel m, bool wet) -> const CaseResult* {
+    for (const CaseResult& c : cases)
+      if (c.grading.name == grading && c.spec.model == m && c.spec.wet == wet) return &c;
+    return nullptr;
+  };
+  auto verdict = [](bool ok) { return ok ? std::string("HOLDS") : std::string("DOES NOT HOLD"); };
+  const std::size_t nl = max_loops(cases);
+
+  // 1. Hysteresis loops larger for hill than for linear.
+  {
+    std::string detail;
+    bool ok = true, any = false;
+    for (const char* g : {"C5n", "C5b"}) {
+      const CaseResult *h = find(g, GrainModel::Hill, false), *l = find(g, GrainModel::Linear, false);
+      if (!h || !l) continue;
+      for (std::size_t k = 0; k < std::min(h->test.loops.size(), l->test.loops.size()); ++k) {
+        const double a = h->test.loops[k].loop_area, b = l->test.loops[k].loop_area;
+        detail += fmt::format("{}{} cycle {}: hill {:.3g} vs linear {:.3g} J/m³ (x{:.2f})", detail.empty() ? "" : "; ", g, k + 1, a, b,
+                              b > 0 ? a / b : 0.0);
+        ok = ok && a > b;
+        any = true;
+      }
+    }
+    if (any) out.push_back("hysteresis loops larger for hill than for linear: " + detail + " -> " + verdict(ok));
+  }
+  // 2-3. C5b stiffer and stronger than C5n, more so for hill.
+  {
+    std::map<GrainModel, std::pair<std::vector<double>, double>> ratios;  // M_r ratios per cycle, peak ratio
+    std::string stiff, strong;
+    bool ok_stiff = true, ok_strong = true, any = false;
+    for (GrainModel m : {GrainModel::Linear, GrainModel::Hill}) {
+      const CaseResult *b = find("C5b", m, false), *n = find("C5n", m, false);
+      if (!b || !n) continue;
+      any = true;
+      auto& r = ratios[m];
+      for (std::size_t k = 0; k < std::min(b->test.loops.size(), n->test.loops.size()); ++k) {
+        const double x = b->test.loops[k].unload_secant, y = n->test.loops[k].unload_secant;
+        r.first.push_back(y > 0 ? x / y : 0.0);
+        stiff += fmt::format("{}{} cycle {}: M_r C5b {:.1f} vs C5n {:.1f} MPa (x{:.2f})", stiff.empty() ? "" : "; ", to_string(m), k + 1,
+                             x / 1e6, y / 1e6, r.first.back());
+        ok_stiff = ok_stiff && x > y;
+      }
+      r.second = n->test.peak_q > 0 ? b->test.peak_q / n->test.peak_q : 0.0;
+      strong += fmt::format("{}{}: peak q C5b {:.1f} vs C5n {:.1f} kPa (x{:.2f})", strong.empty() ? "" : "; ", to_string(m),
+                            b->test.peak_q / 1e3, n->test.peak_q / 1e3, r.second);
+      ok_strong = ok_strong && b->test.peak_q > n->test.peak_q;
+    }
+    if (any) {
+      out.push_back("C5b stiffer than C5n: " + stiff + " -> " + verdict(ok_stiff));
+      out.push_back("C5b stronger than C5n: " + strong + " -> " + verdict(ok_strong));
+    }
+    if (ratios.count(GrainModel::Hill) && ratios.count(GrainModel::Linear)) {
+      const auto &h = ratios[GrainModel::Hill], &l = ratios[GrainModel::Linear];
+      std::string d;
+      bool ok = h.second > l.second;
+      for (std::size_t k = 0; k < std::min(h.first.size(), l.first.size()); ++k) {
+        d += fmt::format("{}M_r ratio cycle {}: hill x{:.2f} vs linear x{:.2f}", d.empty() ? "" : "; ", k + 1, h.first[k], l.first[k]);
+        ok = ok && h.first[k] > l.first[k];
+      }
+      d += fmt::format("; peak-q ratio: hill x{:.2f} vs linear x{:.2f}", h.second, l.second);
+      out.push_back("the C5b/C5n difference is larger for hill: " + d + " -> " + verdict(ok));
+    }
+  }
+  // 4. Wet C5b hill has a higher resilient modulus than dry.
+  {
+    const CaseResult *w = find("C5b", GrainModel::Hill, true), *d = find("C5b", GrainModel::Hill, false);
+    if (w && d) {
+      std::string detail;
+      bool ok = true;
+      for (std::size_t k = 0; k < std::min(w->test.loops.size(), d->test.loops.size()); ++k) {
+        const double a = w->test.loops[k].unload_secant, b = d->test.loops[k].unload_secant;
+        detail += fmt::format("{}cycle {}: wet {:.1f} vs dry {:.1f} MPa (x{:.2f})", detail.empty() ? "" : "; ", k + 1, a / 1e6, b / 1e6,
+                              b > 0 ? a / b : 0.0);
+        ok = ok && a > b;
+      }
+      out.push_back("wet C5b hill has a higher resilient modulus than dry: " + detail + " -> " + verdict(ok));
+    }
+  }
+  (void)nl;
+  return out;
+}
+
+StudyResult run_study(const StudySettings& settings, const std::vector<CaseSpec>& cases, std::ostream* log) {
+  validate(settings, cases);
+  const auto t0 = std::chrono::steady_clock::now();
+  const fs::path out = settings.output_dir;
+  fs::create_directories(out);
+  struct Packed {
+    Specimen specimen;
+    GradingReport report;
+    SpecimenState state;
+  };
+  std::map<std::string, Packed> packed;  // by grading key
+  StudyResult study;
+  for (const CaseSpec& c : cases) {
+    const auto tc = std::chrono::steady_clock::now();
+    const Grading grading = resolve_grading(c.grading);
+    if (log) *log << fmt::format("\n=== {} ===\n", c.name());
+    auto it = packed.find(grading.name);
+    if (it == packed.end()) {
+      Packed p;
+      if (!settings.specimen_file.empty()) {
+        PackingSettings ps;
+        p.specimen = load_packed_specimen(settings.specimen_file, &ps);
+        if (log)
+          *log << fmt::format("specimen {}: {} grains of {} packed at {:g} kPa (seed {})\n", settings.specimen_file,
+                              p.specimen.sim.balls.size(), p.specimen.grading, p.specimen.pressure / 1e3, p.specimen.seed);
+        if (p.specimen.grading != grading.name && log)
+          *log << fmt::format("note: the specimen was packed from grading '{}'; its distribution is compared with '{}'\n",
+                              p.specimen.grading, grading.name);
+      } else {
+        GenesisSpec g = settings.genesis;
+        g.grading = grading;
+        p.specimen = pack_specimen(g, log);
+        if (settings.save_specimens) {
+          const fs::path file = out / "specimens" / (grading.name + "_packed.csv");
+          save_packed_specimen(p.specimen, g.packing, file.string());
+          if (log) *log << "packed specimen saved: " << file.string() << "\n";
+        }
+      }
+      p.report = grading_report(grading, p.specimen.d_mult, p.specimen.diameters());
+      p.state = measure(p.specimen);
+      if (log) *log << p.report.text();
+      it = packed.emplace(grading.name, std::move(p)).first;
+    }
+    CaseResult r;
+    r.spec = c;
+    r.grading = it->second.report;
+    r.packed = it->second.state;
+    Specimen s = it->second.specimen;  // a copy: every case starts from the same packed state
+    Class5Material m = settings.material;
+    m.model = c.model;
+    EquilibriumSettings e = settings.finalize;
+    finalize(s, m, settings.test_walls, e, log);
+    if (c.wet) make_specimen_wet(s, settings.suction, settings.moisture_gap, e, log);
+    r.initial = measure(s);
+    r.phases = s.phases;
+    r.test = run_triaxial(s, settings.triaxial, log);
+    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - tc).count();
+    const fs::path dir = out / c.name();
+    r.dir = dir.string();
+    write_file(dir / "history.csv", r.test.history_csv());
+    write_file(dir / "loops.csv", loops_csv(r.test.loops));
+    write_file(dir / "gsd.csv", r.grading.csv());
+    std::string gen = fmt::format("case {}: grading {}, material {}, {}\n", c.name(), r.grading.name, to_string(c.model),
+                                  c.wet ? fmt::format("wet (make_wet {:g} kPa, {:g} mm)", settings.suction / 1e3, settings.moisture_gap * 1e3)
+                                        : "dry");
+    for (const PhaseReport& p : r.phases) gen += p.line() + "\n";
+    gen += state_text("packed", r.packed) + state_text("test start", r.initial);
+    gen += r.grading.text() + r.test.loops_text();
+    write_file(dir / "genesis.txt", gen);
+    study.cases.push_back(std::move(r));
+    study.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    write_file(out / "summary.csv", study.summary_csv());
+    write_file(out / "summary.md", study.summary_markdown());
+  }
+  return study;
+}
+
+}  // namespace hilldem

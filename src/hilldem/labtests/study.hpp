@@ -1,0 +1,65 @@
+// The memo's Class 5 study (docs/spec/hill-model.md §5.3) as one driver: for each case (grading ×
+// material, dry or wet) a packed specimen (made once per grading, or loaded), finalization, optional
+// wetting and a triaxial test; per case a CSV history, the realised grading and the genesis log; for
+// the study a summary table and the memo's qualitative findings checked with numbers.
+#pragma once
+
+#include <iosfwd>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "hilldem/labtests/genesis.hpp"
+#include "hilldem/labtests/triaxial.hpp"
+
+namespace hilldem {
+
+struct CaseSpec {
+  std::string grading = "C5b";  // "C5n", "C5b" or a grading CSV file
+  GrainModel model = GrainModel::Hill;
+  bool wet = false;
+  std::string name() const;  // "C5b_Hill", "C5b_Hill_wet", "<file stem>_Linear"
+};
+
+// The memo's five cases: C5n/C5b × linear/hill, plus C5b hill wet.
+std::vector<CaseSpec> memo_cases();
+
+struct StudySettings {
+  GenesisSpec genesis;                  // vessel, packing; its grading is replaced by each case's
+  Class5Material material;              // Table 7; `model` is replaced by each case's
+  WallContact test_walls;               // grain-wall contacts after finalization
+  EquilibriumSettings finalize;         // servo equilibrium after finalization and wetting
+  double suction = 20e3;                // ψ of make_wet [Pa]
+  double moisture_gap = 3e-3;           // g_m of make_wet [m]
+  TriaxialSettings triaxial;
+  std::string output_dir = "out/triaxial";
+  std::string specimen_file;            // start from this packed specimen instead of packing
+  bool save_specimens = true;           // write <output>/specimens/<grading>_packed.csv
+};
+// Every check that can be made before work starts (throws InputError): settings ranges, gradings
+// resolvable, wet only with hill, the specimen file readable.
+void validate(const StudySettings& s, const std::vector<CaseSpec>& cases);
+
+struct CaseResult {
+  CaseSpec spec;
+  GradingReport grading;
+  SpecimenState packed;                 // after packing (frictionless)
+  SpecimenState initial;                // after finalization (and wetting): the test's start
+  std::vector<PhaseReport> phases;      // genesis phases of this case (packing shared by a grading)
+  TriaxialResult test;
+  double seconds = 0.0;                 // finalization + wetting + test (packing counted once, in its phase)
+  std::string dir;                      // output folder of the case
+};
+
+struct StudyResult {
+  std::vector<CaseResult> cases;
+  double seconds = 0.0;
+  std::string summary_csv() const;
+  std::string summary_markdown() const;  // the table and the findings
+  std::vector<std::string> findings() const;  // the memo's qualitative claims, each with numbers and a verdict
+};
+
+// Runs the cases, writing into settings.output_dir as it goes; progress to log (may be null).
+StudyResult run_study(const StudySettings& settings, const std::vector<CaseSpec>& cases, std::ostream* log);
+
+}  // namespace hilldem

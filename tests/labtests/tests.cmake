@@ -1,0 +1,56 @@
+# Lab tests (src/hilldem/labtests/): grading, servo, genesis, triaxial, study; included from
+# tests/CMakeLists.txt. Every test runs on a miniature specimen (about 340 grains): seconds, not minutes.
+add_executable(hilldem_labtests_tests
+  labtests/test_gsd.cpp
+  labtests/test_servo.cpp
+  labtests/test_triaxial.cpp
+)
+target_link_libraries(hilldem_labtests_tests PRIVATE hilldem::core GTest::gtest_main)
+target_compile_definitions(hilldem_labtests_tests PRIVATE HILLDEM_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+target_compile_options(hilldem_labtests_tests PRIVATE -Wall -Wextra -Wpedantic)
+# One thread per test: ctest runs tests side by side, and these specimens are too small to gain from more.
+gtest_discover_tests(hilldem_labtests_tests DISCOVERY_TIMEOUT 60
+  PROPERTIES TIMEOUT 120 LABELS labtests ENVIRONMENT OMP_NUM_THREADS=1)
+
+# `hilldem triaxial`: bad options stop with exit status 2 before any work (nothing printed, no folder).
+set(HILLDEM_TRIAXIAL_OUT ${CMAKE_CURRENT_BINARY_DIR}/triaxial_cli_out)
+add_test(NAME cli.triaxial_unknown_grading_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "unknown grading 'C5x'" --stderr "choose C5n, C5b" --not-stdout "cloud"
+          2 $<TARGET_FILE:hilldem> triaxial --grading C5x -o ${HILLDEM_TRIAXIAL_OUT}/bad1)
+add_test(NAME cli.triaxial_negative_pressure_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "--pressure must be > 0 Pa, got -150000" --not-stdout "cloud"
+          2 $<TARGET_FILE:hilldem> triaxial --pressure=-150e3 -o ${HILLDEM_TRIAXIAL_OUT}/bad2)
+add_test(NAME cli.triaxial_cycles_out_of_order_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "cycle strains must be positive and increasing" --not-stdout "cloud"
+          2 $<TARGET_FILE:hilldem> triaxial --cycles 0.05,0.02 -o ${HILLDEM_TRIAXIAL_OUT}/bad3)
+add_test(NAME cli.triaxial_final_below_cycles_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "final strain (0.03 %) must exceed the last cycle strain (0.05 %)"
+          2 $<TARGET_FILE:hilldem> triaxial --final-strain 0.03 -o ${HILLDEM_TRIAXIAL_OUT}/bad4)
+add_test(NAME cli.triaxial_wet_linear_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "--wet needs the hill material"
+          2 $<TARGET_FILE:hilldem> triaxial --material linear --wet -o ${HILLDEM_TRIAXIAL_OUT}/bad5)
+add_test(NAME cli.triaxial_unknown_material_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "unknown material 'steel'"
+          2 $<TARGET_FILE:hilldem> triaxial --material steel -o ${HILLDEM_TRIAXIAL_OUT}/bad6)
+add_test(NAME cli.triaxial_bad_grading_file_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "volume fractions sum to 0.9"
+          2 $<TARGET_FILE:hilldem> triaxial --grading ${HILLDEM_TEST_DATA}/labtests/bad_sum.csv -o ${HILLDEM_TRIAXIAL_OUT}/bad7)
+add_test(NAME cli.triaxial_missing_specimen_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "cannot open the specimen file"
+          2 $<TARGET_FILE:hilldem> triaxial --specimen ${HILLDEM_TEST_DATA}/labtests/no_such_specimen.csv -o ${HILLDEM_TRIAXIAL_OUT}/bad8)
+# A refused run creates no output folder.
+add_test(NAME cli.triaxial_refused_run_writes_nothing
+  COMMAND bash -c "rm -rf \"$1\"; \"$0\" triaxial --cycles 0.05,0.02 -o \"$1\" 2>/dev/null; test $? -eq 2 && test ! -e \"$1\""
+          $<TARGET_FILE:hilldem> ${HILLDEM_TRIAXIAL_OUT}/refused)
+# A miniature run end to end from the stored packed specimen: finalize, wet, one cycle (a few seconds).
+add_test(NAME cli.triaxial_miniature_case_exits_0
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stdout "resilient modulus M_r (unload secant)" --stdout "| fine_Hill_wet |"
+          --stdout "wet contacts" --stdout "summary:"
+          0 $<TARGET_FILE:hilldem> triaxial --specimen ${HILLDEM_TEST_DATA}/labtests/mini_packed.csv
+            --grading ${HILLDEM_TEST_DATA}/labtests/fine.csv --wet --cycles 0.02 --final-strain 0.1 --strain-rate 0.1
+            --final-strain-rate 0.5 --threads 1 --no-plot -o ${HILLDEM_TRIAXIAL_OUT}/mini)
+set_tests_properties(cli.triaxial_unknown_grading_exits_2 cli.triaxial_negative_pressure_exits_2
+  cli.triaxial_cycles_out_of_order_exits_2 cli.triaxial_final_below_cycles_exits_2 cli.triaxial_wet_linear_exits_2
+  cli.triaxial_unknown_material_exits_2 cli.triaxial_bad_grading_file_exits_2 cli.triaxial_missing_specimen_exits_2
+  cli.triaxial_miniature_case_exits_0 cli.triaxial_refused_run_writes_nothing
+  PROPERTIES TIMEOUT 120 LABELS "cli;labtests")
