@@ -12,7 +12,13 @@ build_dir="${1:-build}"
 #   libcli11-dev          command-line parsing (subcommands, typed options, --help)
 #   libfmt-dev            number formatting for tables and CSV
 #   libgtest-dev          GoogleTest, the test framework (run through CTest)
-packages=(g++ cmake make libtomlplusplus-dev libcli11-dev libfmt-dev libgtest-dev)
+#   python3-vtk9          VTK's own XML reader, to prove in a test that snapshots open in ParaView/VTK
+#   python3-matplotlib    the plots of histories (scripts/plot_history.py, docs/figures/)
+#   clang, libclang-rt-14-dev, libomp-14-dev
+#                         libFuzzer with AddressSanitizer/UBSan for the fuzz targets (fuzz/, run
+#                         bounded by a test), and OpenMP for that clang build
+packages=(g++ cmake make libtomlplusplus-dev libcli11-dev libfmt-dev libgtest-dev
+          python3-vtk9 python3-matplotlib clang libclang-rt-14-dev libomp-14-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

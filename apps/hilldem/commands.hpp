@@ -18,6 +18,9 @@ struct Command {
 std::vector<Command> add_scenario_commands(CLI::App& app);  // run, check, contacts, quantities
 Command add_verify_command(CLI::App& app);
 Command add_bench_command(CLI::App& app);
+Command add_resume_command(CLI::App& app);   // continue a run from a checkpoint
+Command add_inspect_command(CLI::App& app);  // describe a checkpoint
+Command add_run_output_options(CLI::App& app);  // snapshot/checkpoint options of `run` (after add_scenario_commands)
 Command add_triaxial_command(CLI::App& app);  // material genesis and triaxial tests (labtests/)
 Command add_resume_command(CLI::App& app);   // continue a run from a checkpoint
 Command add_inspect_command(CLI::App& app);  // describe a checkpoint

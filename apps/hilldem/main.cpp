@@ -14,6 +14,9 @@ int main(int argc, char** argv) {
   std::vector<Command> commands = add_scenario_commands(app);
   commands.push_back(add_verify_command(app));
   commands.push_back(add_bench_command(app));
+  commands.push_back(add_resume_command(app));
+  commands.push_back(add_inspect_command(app));
+  commands.push_back(add_run_output_options(app));
   commands.push_back(add_triaxial_command(app));
   commands.push_back(add_resume_command(app));
   commands.push_back(add_inspect_command(app));

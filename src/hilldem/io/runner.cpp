@@ -68,6 +68,23 @@ std::string probe_table(const RunResult& res) {
   return out;
 }
 
+void OutputOverrides::apply(Scenario& sc) const {
+  if (snapshot_every) {
+    sc.snapshots.enabled = true;
+    sc.snapshots.every = *snapshot_every;
+  }
+  if (snapshot_binary) sc.snapshots.binary = *snapshot_binary;
+  if (checkpoint_every) sc.checkpoints.every = *checkpoint_every;
+  if (checkpoint_seconds) sc.checkpoints.every_seconds = *checkpoint_seconds;
+  if (no_checkpoints) sc.checkpoints.enabled = false;
+  if (blowup_fraction) sc.blowup_fraction = *blowup_fraction;
+}
+
+OutputOverrides& output_overrides() {
+  static OutputOverrides o;
+  return o;
+}
+
 double evaluate(const Scenario& sc, const Quantity& q, int servo) {
   if (servo < 0) return evaluate(sc.sim, q);
   const Servo& s = sc.servos[static_cast<std::size_t>(servo)].servo;
@@ -435,6 +452,25 @@ class Runner {
       s.u64(seq_);
     }
     {
+      // The output settings this run uses (the scenario's, or the command line's over them).
+      SectionWriter& s = w.section("run.settings");
+      const SnapshotSettings& sn = sc_.snapshots;
+      s.boolean(sn.enabled);
+      s.i64(sn.every);
+      s.boolean(sn.at_stage_ends);
+      s.boolean(sn.contacts);
+      s.boolean(sn.walls);
+      s.boolean(sn.binary);
+      s.str(sn.folder);
+      const CheckpointSettings& c = sc_.checkpoints;
+      s.boolean(c.enabled);
+      s.i64(c.every);
+      s.f64(c.every_seconds);
+      s.boolean(c.at_stage_ends);
+      s.i64(c.keep);
+      s.f64(sc_.blowup_fraction);
+    }
+    {
       SectionWriter& s = w.section("run.servos");
       s.u64(sc_.servos.size());
       for (const ScenarioServo& sv : sc_.servos) {
@@ -731,6 +767,7 @@ void restore_scenario(const CheckpointReader& r, Scenario& sc) {
 }  // namespace
 
 RunResult run_scenario(Scenario& sc, const RunOptions& options, std::ostream& log) {
+  output_overrides().apply(sc);
   const std::string dir = options.output_dir.empty() ? sc.output_dir : options.output_dir;
   Runner runner(sc, options, log);
   return runner.run(dir);
@@ -776,6 +813,29 @@ RunResult resume_scenario(const std::string& path, Scenario& sc, const RunOption
                               "run's checkpoints/ folder instead");
   }
   restore_scenario(r, sc);
+  {
+    SectionReader s = r.section("run.settings");
+    SnapshotSettings& sn = sc.snapshots;
+    sn.enabled = s.boolean();
+    sn.every = s.i64();
+    sn.at_stage_ends = s.boolean();
+    sn.contacts = s.boolean();
+    sn.walls = s.boolean();
+    sn.binary = s.boolean();
+    sn.folder = s.str(4096);
+    CheckpointSettings& c = sc.checkpoints;
+    c.enabled = s.boolean();
+    c.every = s.i64();
+    c.every_seconds = s.f64();
+    c.at_stage_ends = s.boolean();
+    const std::int64_t keep = s.i64();
+    sc.blowup_fraction = s.f64();
+    s.finish();
+    if (sn.every < 0 || c.every < 0 || !(c.every_seconds >= 0.0) || keep < 1 || keep > 1000 || !(sc.blowup_fraction >= 0.0) ||
+        sn.folder.empty() || sn.folder.find('/') != std::string::npos || sn.folder == "." || sn.folder == "..")
+      s.fail("output settings out of range");
+    c.keep = static_cast<int>(keep);
+  }
   std::string dir = options.output_dir;
   if (dir.empty()) {
     const fs::path parent = fs::absolute(fs::path(file)).parent_path();

@@ -54,6 +54,21 @@ struct RunResult {
   const ProbeValue* find(const std::string& label) const;
 };
 
+// Output settings given on the command line (hilldem run --snapshots-every N ...), applied over the
+// scenario's [snapshots], [checkpoints] and blowup_fraction by run_scenario. The CLI fills them while
+// parsing; nothing else should. The settings a run used are saved in its checkpoints, so
+// resume_scenario continues with them.
+struct OutputOverrides {
+  std::optional<std::int64_t> snapshot_every;     // turns snapshots on; 0: at stage ends only
+  std::optional<bool> snapshot_binary;
+  std::optional<std::int64_t> checkpoint_every;   // [steps]
+  std::optional<double> checkpoint_seconds;       // [s]
+  bool no_checkpoints = false;
+  std::optional<double> blowup_fraction;
+  void apply(Scenario& sc) const;
+};
+OutputOverrides& output_overrides();
+
 // Runs every stage in order. Stage lines and listings go to `log`. Throws RunError when a stage
 // fails, InputError when an output cannot be created.
 RunResult run_scenario(Scenario& sc, const RunOptions& options, std::ostream& log);
