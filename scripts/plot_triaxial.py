@@ -144,7 +144,7 @@ def main():
             a.set_xlabel("axial strain [%]")
         for r_ in axes:
             r_[0].set_ylabel("q [kPa]")
-        fig.suptitle("Load-unload cycles at 0.02 % and 0.05 % axial strain (cf. memo Fig. 21)", fontsize=11)
+        fig.suptitle("Load-unload cycles (cf. memo Fig. 21)", fontsize=11)
         fig.tight_layout()
         written.append(os.path.join(out, "fig21_cycles.png"))
         fig.savefig(written[-1], dpi=130)

@@ -2,7 +2,9 @@
 // materials, one case or the whole study (docs/lab-tests.md).
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
@@ -43,6 +45,7 @@ struct Options {
   double finalize_ratio = 0.0;
   std::string specimen;
   bool no_plot = false;
+  bool pack_only = false;
   int threads = 0;
   bool quiet = false;
 };
@@ -83,6 +86,9 @@ std::pair<StudySettings, std::vector<CaseSpec>> build(const Options& o) {
   if (o.study) {
     if (o.wet) throw InputError("--wet and --study: the study already has its wet case");
     if (!o.specimen.empty()) throw InputError("--specimen and --study: the study packs one specimen per grading");
+  }
+  if (o.pack_only && !o.specimen.empty()) throw InputError("--pack-only and --specimen: nothing to pack");
+  if (o.study) {
     cases = memo_cases();
     s.output_dir = o.output.empty() ? "out/study" : o.output;
   } else {
@@ -116,10 +122,28 @@ int run(const Options& o) {
                         cases.size() > 1 ? "s" : "", 2e3 * settings.genesis.vessel_radius, 1e3 * settings.genesis.vessel_height,
                         settings.genesis.vessel_radius == kMemoRadius ? " (the memo's)" : " (scaled; --full for the memo's 170 mm x 240 mm)",
                         settings.output_dir);
+  if (o.pack_only) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::clock_t c0 = std::clock();
+    std::vector<PackedResult> packed;
+    std::vector<std::string> done;
+    for (const CaseSpec& c : cases) {
+      const std::string name = resolve_grading(c.grading).name;
+      if (std::find(done.begin(), done.end(), name) != done.end()) continue;
+      done.push_back(name);
+      if (log) *log << fmt::format("\n=== packing {} ===\n", name);
+      packed.push_back(make_packed(settings, c.grading, true, log));
+    }
+    std::cout << "\n" << packing_table(packed);
+    std::cout << fmt::format("\nspecimens: {}/specimens/; {:.0f} s wall, {:.0f} s CPU\n", settings.output_dir,
+                             std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+                             static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC);
+    return 0;
+  }
   const StudyResult result = run_study(settings, cases, log);
   std::cout << "\n" << result.summary_markdown();
-  std::cout << fmt::format("\nsummary: {}/summary.csv, {}/summary.md; {:.0f} s in all\n", settings.output_dir, settings.output_dir,
-                           result.seconds);
+  std::cout << fmt::format("\nsummary: {}/summary.csv, {}/summary.md; {:.0f} s wall, {:.0f} s CPU in all\n", settings.output_dir,
+                           settings.output_dir, result.seconds, result.cpu_seconds);
   if (!o.no_plot) {
     const std::string script = find_plot_script();
     if (script.empty()) {
@@ -161,6 +185,8 @@ Command add_triaxial_command(CLI::App& app) {
   cmd->add_option("--d-mult", o->d_mult, "diameter multiplier D_mult (default 1)");
   cmd->add_option("--finalize-ratio", o->finalize_ratio, "equilibrium ratio after finalization and wetting (default 8e-3)");
   cmd->add_option("--specimen", o->specimen, "start from a saved packed specimen (out/.../specimens/<grading>_packed.csv)");
+  cmd->add_flag("--pack-only", o->pack_only,
+                "genesis only: pack the specimen(s) and save them to <output>/specimens/ for later --specimen runs");
   cmd->add_flag("--no-plot", o->no_plot, "do not run scripts/plot_triaxial.py");
   cmd->add_option("--threads", o->threads, "OpenMP threads (0: default)")->check(CLI::Range(0, 1024));
   cmd->add_flag("-q,--quiet", o->quiet, "only the summary");

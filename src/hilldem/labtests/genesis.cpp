@@ -6,6 +6,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <numbers>
 #include <numeric>
@@ -113,7 +114,7 @@ std::vector<double> Specimen::diameters() const {
   return d;
 }
 
-SpecimenState measure(const Specimen& s) {
+SpecimenState measure(const Specimen& s, bool interior) {
   const Simulation& sim = s.sim;
   SpecimenState st;
   st.grains = sim.balls.size();
@@ -125,9 +126,10 @@ SpecimenState measure(const Specimen& s) {
   double d_max = 0.0;
   for (double r : sim.balls.radius) d_max = std::max(d_max, 2.0 * r);
   const MeasurementCylinder region{st.radius - d_max, s.vessel.bottom_z(sim) + d_max, s.vessel.top_z(sim) - d_max};
-  st.interior_porosity = region.radius > 0.0 && region.z_hi > region.z_lo
+  // The region must hold at least one D_max across and two in height, else there is no interior.
+  st.interior_porosity = interior && region.radius >= d_max && region.z_hi - region.z_lo >= 2.0 * d_max
                              ? region_porosity(region, sim.balls.position, sim.balls.radius)
-                             : st.porosity;
+                             : std::numeric_limits<double>::quiet_NaN();
   std::vector<std::uint32_t> per_ball(st.grains, 0);
   std::size_t touching = 0;
   for (std::size_t c = 0; c < sim.contacts.size(); ++c) {

@@ -54,7 +54,8 @@ void validate(const GenesisSpec& spec);
 struct SpecimenState {
   std::size_t grains = 0;
   double porosity = 0.0;            // 1 − V_solid / (π R² H) [-]: the whole vessel
-  double interior_porosity = 0.0;   // in the coaxial cylinder one D_max in from every wall [-] (measure_region.hpp)
+  double interior_porosity = 0.0;   // in the coaxial cylinder one D_max in from every wall [-] (measure_region.hpp);
+                                    // NaN when that leaves less than D_max radius or 2 D_max height
   double coordination = 0.0;        // 2 N_c / N_grains, touching grain-grain contacts [-]
   double mech_coordination = 0.0;   // Thornton's: grains with < 2 contacts left out [-]
   double radial_stress = 0.0;       // lateral wall [Pa]
@@ -86,7 +87,9 @@ struct Specimen {
   std::vector<double> diameters() const;
 };
 
-SpecimenState measure(const Specimen& s);
+// The specimen's state; `interior` false skips the measurement-cylinder porosity (set to the vessel's),
+// for frequent records.
+SpecimenState measure(const Specimen& s, bool interior = true);
 
 // The cloud: grains sampled from the grading for porosity n_c in the vessel and placed at random
 // (best of placement_tries positions, largest grains first; overlaps allowed), packing table

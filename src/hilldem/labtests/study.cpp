@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -110,7 +111,7 @@ std::string StudyResult::summary_csv() const {
     out += fmt::format(",eps_A_cycle{0}[-],Mr_unload_secant_cycle{0}[Pa],reload_secant_cycle{0}[Pa],loop_area_cycle{0}[J/m3],"
                        "damping_ratio_cycle{0}[-]",
                        k);
-  out += ",worst_confinement_error[-],worst_platen_mismatch[-],test_steps,seconds\n";
+  out += ",worst_confinement_error[-],worst_platen_mismatch[-],test_steps,packing_seconds,seconds\n";
   for (const CaseResult& c : cases) {
     out += fmt::format("{},{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.9g},{:.9g},{:.9g},{:.6g}", c.spec.name(),
                        c.grading.name, to_string(c.spec.model), c.spec.wet ? 1 : 0, c.initial.grains, c.packed.porosity,
@@ -125,8 +126,8 @@ std::string StudyResult::summary_csv() const {
         out += ",,,,,";
       }
     }
-    out += fmt::format(",{:.6g},{:.6g},{},{:.1f}\n", c.test.worst_confinement_error, c.test.worst_platen_mismatch, c.test.steps,
-                       c.seconds);
+    out += fmt::format(",{:.6g},{:.6g},{},{:.1f},{:.1f}\n", c.test.worst_confinement_error, c.test.worst_platen_mismatch,
+                       c.test.steps, c.packing_seconds, c.seconds);
   }
   return out;
 }
@@ -139,8 +140,8 @@ std::string StudyResult::summary_markdown() const {
     head += fmt::format(" M_r c{0} [MPa] | reload c{0} [MPa] | loop c{0} [J/m³] |", k);
     rule += "---:|---:|---:|";
   }
-  head += " worst sigma_r error [%] | worst platen mismatch [%] | time [s] |";
-  rule += "---:|---:|---:|";
+  head += " worst sigma_r error [%] | worst platen mismatch [%] | test steps | time [s] |";
+  rule += "---:|---:|---:|---:|";
   std::string out = head + "\n" + rule + "\n";
   for (const CaseResult& c : cases) {
     out += fmt::format("| {} | {} | {:.4f} / {:.4f} | {:.4f} / {:.4f} | {:.2f} | {:.1f} | {:.3f} |", c.spec.name(), c.initial.grains,
@@ -155,12 +156,13 @@ std::string StudyResult::summary_markdown() const {
         out += " | | |";
       }
     }
-    out += fmt::format(" {:.2f} | {:.2f} | {:.0f} |\n", 100 * c.test.worst_confinement_error, 100 * c.test.worst_platen_mismatch,
-                       c.seconds);
+    out += fmt::format(" {:.2f} | {:.2f} | {} | {:.0f} |\n", 100 * c.test.worst_confinement_error, 100 * c.test.worst_platen_mismatch,
+                       c.test.steps, c.seconds);
   }
   out += "\nM_r: resilient modulus, unload secant (q_A − q_B)/(eps_A − eps_B); reload: reload secant (q_C − q_B)/(eps_A − eps_B);\n"
          "loop: hysteresis, loop area ∮ q d(eps_a) = energy dissipated per unit volume. Z: touching grain-grain contacts per grain.\n"
-         "Porosity: vessel = 1 − V_grains/(π R² H); interior = in the coaxial cylinder one D_max in from every wall.\n";
+         "Porosity: vessel = 1 − V_grains/(π R² H); interior = in the coaxial cylinder one D_max in from every wall.\n"
+         "Time: finalization, wetting and test of the case (wall clock); packing is done once per grading.\n";
   const auto f = findings();
   if (!f.empty()) {
     out += "\nFindings of the memo, checked:\n\n";
@@ -227,10 +229,10 @@ std::vector<std::string> StudyResult::findings() const {
       std::string d;
       bool ok = h.second > l.second;
       for (std::size_t k = 0; k < std::min(h.first.size(), l.first.size()); ++k) {
-        d += fmt::format("{}M_r ratio cycle {}: hill x{:.2f} vs linear x{:.2f}", d.empty() ? "" : "; ", k + 1, h.first[k], l.first[k]);
+        d += fmt::format("{}M_r ratio cycle {}: hill x{:.3f} vs linear x{:.3f}", d.empty() ? "" : "; ", k + 1, h.first[k], l.first[k]);
         ok = ok && h.first[k] > l.first[k];
       }
-      d += fmt::format("; peak-q ratio: hill x{:.2f} vs linear x{:.2f}", h.second, l.second);
+      d += fmt::format("; peak-q ratio: hill x{:.3f} vs linear x{:.3f}", h.second, l.second);
       out.push_back("the C5b/C5n difference is larger for hill: " + d + " -> " + verdict(ok));
     }
   }
@@ -253,53 +255,80 @@ std::vector<std::string> StudyResult::findings() const {
   return out;
 }
 
+PackedResult make_packed(const StudySettings& settings, const std::string& grading_name, bool save, std::ostream* log) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const Grading grading = resolve_grading(grading_name);
+  const fs::path dir = fs::path(settings.output_dir) / "specimens";
+  PackedResult p;
+  PackingSettings ps = settings.genesis.packing;
+  if (!settings.specimen_file.empty()) {
+    p.specimen = load_packed_specimen(settings.specimen_file, &ps);
+    p.file = settings.specimen_file;
+    if (log)
+      *log << fmt::format("specimen {}: {} grains of {} packed at {:g} kPa (seed {})\n", settings.specimen_file,
+                          p.specimen.sim.balls.size(), p.specimen.grading, p.specimen.pressure / 1e3, p.specimen.seed);
+    if (p.specimen.grading != grading.name && log)
+      *log << fmt::format("note: the specimen was packed from grading '{}'; its distribution is compared with '{}'\n",
+                          p.specimen.grading, grading.name);
+  } else {
+    GenesisSpec g = settings.genesis;
+    g.grading = grading;
+    p.specimen = pack_specimen(g, log);
+    if (save) {
+      p.file = (dir / (grading.name + "_packed.csv")).string();
+      save_packed_specimen(p.specimen, g.packing, p.file);
+      if (log) *log << "packed specimen saved: " << p.file << "\n";
+    }
+  }
+  p.report = grading_report(grading, p.specimen.d_mult, p.specimen.diameters());
+  p.state = measure(p.specimen);
+  p.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (log) *log << p.report.text() << state_text("packed", p.state);
+  if (save && settings.specimen_file.empty()) {
+    write_file(dir / (grading.name + "_gsd.csv"), p.report.csv());
+    std::string gen = fmt::format("grading {}, seed {}, vessel {:g} mm x {:g} mm, P_m {:g} kPa\n", grading.name, p.specimen.seed,
+                                  2e3 * settings.genesis.vessel_radius, 1e3 * settings.genesis.vessel_height,
+                                  settings.genesis.packing.equilibrium.pressure / 1e3);
+    for (const PhaseReport& ph : p.specimen.phases) gen += ph.line() + "\n";
+    gen += state_text("packed", p.state) + p.report.text();
+    write_file(dir / (grading.name + "_genesis.txt"), gen);
+  }
+  return p;
+}
+
+std::string packing_table(const std::vector<PackedResult>& packed) {
+  std::string out = "| grading | seed | grains | porosity (vessel) | porosity (interior) | Z | sigma_r [kPa] | sigma_bottom [kPa] | "
+                    "sigma_top [kPa] | packing steps | time [s] |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (const PackedResult& p : packed) {
+    std::int64_t steps = 0;
+    for (const PhaseReport& ph : p.specimen.phases) steps += ph.steps;
+    out += fmt::format("| {} | {} | {} | {:.4f} | {:.4f} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {} | {:.0f} |\n", p.report.name,
+                       p.specimen.seed, p.state.grains, p.state.porosity, p.state.interior_porosity, p.state.coordination,
+                       p.state.radial_stress / 1e3, p.state.bottom_stress / 1e3, p.state.top_stress / 1e3, steps, p.seconds);
+  }
+  return out;
+}
+
 StudyResult run_study(const StudySettings& settings, const std::vector<CaseSpec>& cases, std::ostream* log) {
   validate(settings, cases);
   const auto t0 = std::chrono::steady_clock::now();
+  const std::clock_t c0 = std::clock();
   const fs::path out = settings.output_dir;
   fs::create_directories(out);
-  struct Packed {
-    Specimen specimen;
-    GradingReport report;
-    SpecimenState state;
-  };
-  std::map<std::string, Packed> packed;  // by grading key
+  std::map<std::string, PackedResult> packed;  // by grading name: one packing per grading
   StudyResult study;
   for (const CaseSpec& c : cases) {
-    const auto tc = std::chrono::steady_clock::now();
-    const Grading grading = resolve_grading(c.grading);
+    const std::string gname = resolve_grading(c.grading).name;
     if (log) *log << fmt::format("\n=== {} ===\n", c.name());
-    auto it = packed.find(grading.name);
-    if (it == packed.end()) {
-      Packed p;
-      if (!settings.specimen_file.empty()) {
-        PackingSettings ps;
-        p.specimen = load_packed_specimen(settings.specimen_file, &ps);
-        if (log)
-          *log << fmt::format("specimen {}: {} grains of {} packed at {:g} kPa (seed {})\n", settings.specimen_file,
-                              p.specimen.sim.balls.size(), p.specimen.grading, p.specimen.pressure / 1e3, p.specimen.seed);
-        if (p.specimen.grading != grading.name && log)
-          *log << fmt::format("note: the specimen was packed from grading '{}'; its distribution is compared with '{}'\n",
-                              p.specimen.grading, grading.name);
-      } else {
-        GenesisSpec g = settings.genesis;
-        g.grading = grading;
-        p.specimen = pack_specimen(g, log);
-        if (settings.save_specimens) {
-          const fs::path file = out / "specimens" / (grading.name + "_packed.csv");
-          save_packed_specimen(p.specimen, g.packing, file.string());
-          if (log) *log << "packed specimen saved: " << file.string() << "\n";
-        }
-      }
-      p.report = grading_report(grading, p.specimen.d_mult, p.specimen.diameters());
-      p.state = measure(p.specimen);
-      if (log) *log << p.report.text();
-      it = packed.emplace(grading.name, std::move(p)).first;
-    }
+    auto it = packed.find(gname);
+    if (it == packed.end()) it = packed.emplace(gname, make_packed(settings, c.grading, settings.save_specimens, log)).first;
+    const auto tc = std::chrono::steady_clock::now();
     CaseResult r;
+    r.packing_seconds = it->second.seconds;
     r.spec = c;
     r.grading = it->second.report;
     r.packed = it->second.state;
+    r.packing_file = it->second.file;
     Specimen s = it->second.specimen;  // a copy: every case starts from the same packed state
     Class5Material m = settings.material;
     m.model = c.model;
@@ -324,6 +353,7 @@ StudyResult run_study(const StudySettings& settings, const std::vector<CaseSpec>
     write_file(dir / "genesis.txt", gen);
     study.cases.push_back(std::move(r));
     study.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    study.cpu_seconds = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
     write_file(out / "summary.csv", study.summary_csv());
     write_file(out / "summary.md", study.summary_markdown());
   }

@@ -47,13 +47,16 @@ struct CaseResult {
   SpecimenState initial;                // after finalization (and wetting): the test's start
   std::vector<PhaseReport> phases;      // genesis phases of this case (packing shared by a grading)
   TriaxialResult test;
-  double seconds = 0.0;                 // finalization + wetting + test (packing counted once, in its phase)
+  double seconds = 0.0;                 // finalization + wetting + test, wall clock [s]
+  double packing_seconds = 0.0;         // the packing it started from (shared by the cases of a grading) [s]
   std::string dir;                      // output folder of the case
+  std::string packing_file;             // the packed specimen it started from ("" if not saved)
 };
 
 struct StudyResult {
   std::vector<CaseResult> cases;
-  double seconds = 0.0;
+  double seconds = 0.0;                 // wall clock [s]
+  double cpu_seconds = 0.0;             // process CPU time, all threads [s]
   std::string summary_csv() const;
   std::string summary_markdown() const;  // the table and the findings
   std::vector<std::string> findings() const;  // the memo's qualitative claims, each with numbers and a verdict
@@ -61,5 +64,19 @@ struct StudyResult {
 
 // Runs the cases, writing into settings.output_dir as it goes; progress to log (may be null).
 StudyResult run_study(const StudySettings& settings, const std::vector<CaseSpec>& cases, std::ostream* log);
+
+// Genesis up to the packed specimen (cloud, frictionless packing) for one grading, or the specimen
+// loaded from settings.specimen_file; with save, written to <output>/specimens/<grading>_packed.csv
+// with its realised grading (<grading>_gsd.csv) and genesis report (<grading>_genesis.txt).
+struct PackedResult {
+  Specimen specimen;
+  GradingReport report;
+  SpecimenState state;
+  std::string file;     // where it was saved or loaded from
+  double seconds = 0.0;
+};
+PackedResult make_packed(const StudySettings& settings, const std::string& grading, bool save, std::ostream* log);
+// One line per packed specimen: grading, seed, grains, porosities, coordination, pressures, steps, time.
+std::string packing_table(const std::vector<PackedResult>& packed);
 
 }  // namespace hilldem

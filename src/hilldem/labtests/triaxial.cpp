@@ -173,7 +173,7 @@ TriaxialResult run_triaxial(Specimen& s, const TriaxialSettings& t, std::ostream
     return r;
   };
   auto record = [&](TriaxialRow r) {
-    const SpecimenState st = measure(s);
+    const SpecimenState st = measure(s, false);
     r.porosity = st.porosity;
     r.coordination = st.coordination;
     res.history.push_back(r);
