@@ -8,6 +8,7 @@ into OUTPUT_DIR:
   fig18_grading.png        % passing by volume: target and realised, per grading (memo Fig. 18)
   fig20_stress_strain.png  deviator stress and volumetric strain vs axial strain, dry cases (Fig. 20)
   fig21_cycles.png         the load-unload cycles, one panel per dry case (Fig. 21)
+                           (a run with no dry case plots its wet case in these two)
   fig22_wet_dry.png        C5b hill, wet vs dry: whole test and cycles (Fig. 22), when both were run
 Needs matplotlib (Debian: python3-matplotlib; scripts/setup.sh installs it).
 """
@@ -106,7 +107,7 @@ def main():
     fig.savefig(written[-1], dpi=130)
     plt.close(fig)
 
-    dry = [c for c in cases if not c.endswith("_wet")]
+    dry = [c for c in cases if not c.endswith("_wet")] or cases  # the dry cases (all, if a run has no dry case)
     # Fig. 20: whole test, dry cases.
     if dry:
         fig, (a1, a2) = plt.subplots(2, 1, figsize=(6.5, 7), sharex=True)

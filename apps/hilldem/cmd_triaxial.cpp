@@ -149,7 +149,10 @@ int run(const Options& o) {
     if (script.empty()) {
       std::cout << "figures: scripts/plot_triaxial.py not found; skipped\n";
     } else {
-      const std::string cmd = "python3 " + quote(script) + " " + quote(settings.output_dir);
+      // Debian's interpreter is the one python3-matplotlib serves (a python3 earlier on PATH may lack it).
+      const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+      const std::string cmd = python + " " + quote(script) + " " + quote(settings.output_dir);
+      std::cout.flush();
       const int rc = std::system(cmd.c_str());
       if (rc != 0) std::cout << "figures: `" << cmd << "` failed (python3-matplotlib missing?); the CSV results stand\n";
     }

@@ -54,3 +54,9 @@ set_tests_properties(cli.triaxial_unknown_grading_exits_2 cli.triaxial_negative_
   cli.triaxial_unknown_material_exits_2 cli.triaxial_bad_grading_file_exits_2 cli.triaxial_missing_specimen_exits_2
   cli.triaxial_miniature_case_exits_0 cli.triaxial_refused_run_writes_nothing
   PROPERTIES TIMEOUT 120 LABELS "cli;labtests")
+# The figures script on that run's output (Debian's python3 with python3-matplotlib, from scripts/setup.sh).
+add_test(NAME cli.triaxial_plot_script_writes_figures
+  COMMAND bash -c "/usr/bin/python3 \"$0\" \"$1\" && test -s \"$1/fig18_grading.png\" && test -s \"$1/fig20_stress_strain.png\" && test -s \"$1/fig21_cycles.png\""
+          ${PROJECT_SOURCE_DIR}/scripts/plot_triaxial.py ${HILLDEM_TRIAXIAL_OUT}/mini)
+set_tests_properties(cli.triaxial_miniature_case_exits_0 PROPERTIES FIXTURES_SETUP triaxial_mini)
+set_tests_properties(cli.triaxial_plot_script_writes_figures PROPERTIES FIXTURES_REQUIRED triaxial_mini TIMEOUT 120 LABELS "cli;labtests")
