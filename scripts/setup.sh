@@ -14,6 +14,7 @@ build_dir="${1:-build}"
 #   libgtest-dev          GoogleTest, the test framework (run through CTest)
 #   python3-vtk9          VTK's own XML reader, to prove in a test that snapshots open in ParaView/VTK
 #   python3-matplotlib    the plots of histories (scripts/plot_history.py, docs/figures/)
+#                         and the triaxial study's figures (scripts/plot_triaxial.py, memo Figs. 18, 20-22)
 #   clang, libclang-rt-14-dev, libomp-14-dev
 #                         libFuzzer with AddressSanitizer/UBSan for the fuzz targets (fuzz/, run
 #                         bounded by a test), and OpenMP for that clang build
