@@ -14,6 +14,7 @@
 
 #include "commands.hpp"
 #include "hilldem/core/error.hpp"
+#include "hilldem/labtests/specimen_io.hpp"
 #include "hilldem/labtests/study.hpp"
 
 namespace hilldem::cli {
@@ -46,6 +47,7 @@ struct Options {
   std::string specimen;
   bool no_plot = false;
   bool pack_only = false;
+  bool grading_given = false;  // --grading on the command line
   int threads = 0;
   bool quiet = false;
 };
@@ -92,9 +94,15 @@ std::pair<StudySettings, std::vector<CaseSpec>> build(const Options& o) {
     cases = memo_cases();
     s.output_dir = o.output.empty() ? "out/study" : o.output;
   } else {
+    std::string grading = o.grading;
+    if (!o.specimen.empty() && !o.grading_given) {
+      // The specimen's own grading, when it is a built-in one (a file's grading needs --grading FILE).
+      const std::string g = lower(load_packed_specimen(o.specimen).grading);
+      if (g == "c5n" || g == "c5b") grading = g == "c5n" ? "C5n" : "C5b";
+    }
     const std::string m = lower(o.material);
     if (m != "hill" && m != "linear") throw InputError("unknown material '" + o.material + "': choose linear or hill");
-    cases.push_back({o.grading, m == "hill" ? GrainModel::Hill : GrainModel::Linear, o.wet});
+    cases.push_back({grading, m == "hill" ? GrainModel::Hill : GrainModel::Linear, o.wet});
     s.output_dir = o.output.empty() ? "out/triaxial" : o.output;
   }
   validate(s, cases);
@@ -169,7 +177,9 @@ Command add_triaxial_command(CLI::App& app) {
       "Material genesis (grading, boundary-contraction packing, finalization, wetting) and a servo-controlled triaxial "
       "test with load-unload cycles; --study runs the memo's five Class 5 cases");
   cmd->add_flag("--study", o->study, "the memo's study: C5n/C5b x linear/hill, plus C5b hill wet, with a summary and figures");
-  cmd->add_option("--grading", o->grading, "C5n, C5b, or a CSV file of d_lower_mm,d_upper_mm,fraction rows (default C5b)");
+  CLI::Option* grading = cmd->add_option(
+      "--grading", o->grading,
+      "C5n, C5b, or a CSV file of d_lower_mm,d_upper_mm,fraction rows (default C5b, or the --specimen's grading)");
   cmd->add_option("--material", o->material, "grain-grain model: linear or hill (default hill)");
   cmd->add_flag("--wet", o->wet, "make_wet(suction, moisture gap) at the end of genesis (hill only)");
   cmd->add_option("-o,--output", o->output, "output folder (default out/triaxial, or out/study with --study)");
@@ -193,7 +203,10 @@ Command add_triaxial_command(CLI::App& app) {
   cmd->add_flag("--no-plot", o->no_plot, "do not run scripts/plot_triaxial.py");
   cmd->add_option("--threads", o->threads, "OpenMP threads (0: default)")->check(CLI::Range(0, 1024));
   cmd->add_flag("-q,--quiet", o->quiet, "only the summary");
-  return {cmd, [o] { return run(*o); }};
+  return {cmd, [o, grading] {
+            o->grading_given = grading->count() > 0;
+            return run(*o);
+          }};
 }
 
 }  // namespace hilldem::cli
