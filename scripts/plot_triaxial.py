@@ -20,6 +20,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.ticker  # noqa: E402
 
 STYLE = {  # (colour, line style) per case
     "C5n_Linear": ("tab:blue", "--"),
@@ -86,16 +87,22 @@ def main():
     # Fig. 18: grading curves, one per grading.
     fig, ax = plt.subplots(figsize=(6, 4.2))
     seen = set()
+    lo, hi = 1e9, 0.0
     for r in summary:
         g = r["grading"]
         if g in seen:
             continue
         seen.add(g)
         size, target, realised = read_gsd(os.path.join(out, r["case"], "gsd.csv"))
+        lo, hi = min(lo, min(size) * 0.9), max(hi, max(size) * 1.1)
         colour = "tab:red" if g == "C5b" else ("tab:blue" if g == "C5n" else None)
         ax.plot(size, target, color=colour, lw=2.5, alpha=0.35, label=f"{g} target")
         ax.plot(size, realised, color=colour, lw=1.2, label=f"{g} realised ({r['grains']} grains)")
     ax.set_xscale("log")
+    ticks = [t for t in (2, 3, 4, 5, 6, 8, 10, 12, 15, 20, 25, 30, 40, 50, 60, 80, 100) if lo <= t <= hi] if seen else []
+    ax.xaxis.set_major_locator(matplotlib.ticker.FixedLocator(ticks))
+    ax.xaxis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
+    ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     ax.set_xlabel("grain diameter [mm]")
     ax.set_ylabel("passing by volume [%]")
     ax.set_ylim(0, 100)
