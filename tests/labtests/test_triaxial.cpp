@@ -301,12 +301,15 @@ TEST(Study, FindingsAreComputedFromTheNumbers) {
              make("C5b", GrainModel::Hill, true, 3.5, 190e6, 320e3)};
   const auto f = r.findings();
   ASSERT_EQ(f.size(), 5u);
-  EXPECT_NE(f[0].find("HOLDS"), std::string::npos) << f[0];
+  EXPECT_NE(f[0].find("HOLDS (2 of 2 comparisons)"), std::string::npos) << f[0];
   EXPECT_NE(f[0].find("x2.00"), std::string::npos) << f[0];
   EXPECT_NE(f[1].find("HOLDS"), std::string::npos) << f[1];
   EXPECT_NE(f[2].find("HOLDS"), std::string::npos) << f[2];
   EXPECT_NE(f[3].find("HOLDS"), std::string::npos) << f[3];  // hill 200/110 = 1.82 > linear 1.5; peaks 1.43 > 1.25
-  EXPECT_NE(f[4].find("DOES NOT HOLD"), std::string::npos) << f[4];  // wet 190 < dry 200
+  EXPECT_NE(f[4].find("DOES NOT HOLD (0 of 1 comparisons)"), std::string::npos) << f[4];  // wet 190 < dry 200
+  // A claim that holds for some comparisons only says so.
+  r.cases[1].test.loops[0].loop_area = 0.5;  // C5n hill loop now smaller than linear's
+  EXPECT_NE(r.findings()[0].find("HOLDS IN PART (1 of 2 comparisons)"), std::string::npos) << r.findings()[0];
 }
 
 }  // namespace

@@ -178,13 +178,23 @@ std::vector<std::string> StudyResult::findings() const {
       if (c.grading.name == grading && c.spec.model == m && c.spec.wet == wet) return &c;
     return nullptr;
   };
-  auto verdict = [](bool ok) { return ok ? std::string("HOLDS") : std::string("DOES NOT HOLD"); };
+  // Each claim is a set of comparisons; the verdict says how many of them hold.
+  struct Tally {
+    int yes = 0, n = 0;
+    void add(bool b) { yes += b ? 1 : 0, ++n; }
+  };
+  auto verdict = [](const Tally& t) {
+    if (t.yes == t.n) return fmt::format("HOLDS ({} of {} comparisons)", t.yes, t.n);
+    if (t.yes == 0) return fmt::format("DOES NOT HOLD (0 of {} comparisons)", t.n);
+    return fmt::format("HOLDS IN PART ({} of {} comparisons)", t.yes, t.n);
+  };
   const std::size_t nl = max_loops(cases);
 
   // 1. Hysteresis loops larger for hill than for linear.
   {
     std::string detail;
-    bool ok = true, any = false;
+    Tally ok;
+    bool any = false;
     for (const char* g : {"C5n", "C5b"}) {
       const CaseResult *h = find(g, GrainModel::Hill, false), *l = find(g, GrainModel::Linear, false);
       if (!h || !l) continue;
@@ -192,7 +202,7 @@ std::vector<std::string> StudyResult::findings() const {
         const double a = h->test.loops[k].loop_area, b = l->test.loops[k].loop_area;
         detail += fmt::format("{}{} cycle {}: hill {:.3g} vs linear {:.3g} J/m³ (x{:.2f})", detail.empty() ? "" : "; ", g, k + 1, a, b,
                               b > 0 ? a / b : 0.0);
-        ok = ok && a > b;
+        ok.add(a > b);
         any = true;
       }
     }
@@ -202,7 +212,8 @@ std::vector<std::string> StudyResult::findings() const {
   {
     std::map<GrainModel, std::pair<std::vector<double>, double>> ratios;  // M_r ratios per cycle, peak ratio
     std::string stiff, strong;
-    bool ok_stiff = true, ok_strong = true, any = false;
+    Tally ok_stiff, ok_strong;
+    bool any = false;
     for (GrainModel m : {GrainModel::Linear, GrainModel::Hill}) {
       const CaseResult *b = find("C5b", m, false), *n = find("C5n", m, false);
       if (!b || !n) continue;
@@ -213,12 +224,12 @@ std::vector<std::string> StudyResult::findings() const {
         r.first.push_back(y > 0 ? x / y : 0.0);
         stiff += fmt::format("{}{} cycle {}: M_r C5b {:.1f} vs C5n {:.1f} MPa (x{:.2f})", stiff.empty() ? "" : "; ", to_string(m), k + 1,
                              x / 1e6, y / 1e6, r.first.back());
-        ok_stiff = ok_stiff && x > y;
+        ok_stiff.add(x > y);
       }
       r.second = n->test.peak_q > 0 ? b->test.peak_q / n->test.peak_q : 0.0;
       strong += fmt::format("{}{}: peak q C5b {:.1f} vs C5n {:.1f} kPa (x{:.2f})", strong.empty() ? "" : "; ", to_string(m),
                             b->test.peak_q / 1e3, n->test.peak_q / 1e3, r.second);
-      ok_strong = ok_strong && b->test.peak_q > n->test.peak_q;
+      ok_strong.add(b->test.peak_q > n->test.peak_q);
     }
     if (any) {
       out.push_back("C5b stiffer than C5n: " + stiff + " -> " + verdict(ok_stiff));
@@ -227,10 +238,11 @@ std::vector<std::string> StudyResult::findings() const {
     if (ratios.count(GrainModel::Hill) && ratios.count(GrainModel::Linear)) {
       const auto &h = ratios[GrainModel::Hill], &l = ratios[GrainModel::Linear];
       std::string d;
-      bool ok = h.second > l.second;
+      Tally ok;
+      ok.add(h.second > l.second);
       for (std::size_t k = 0; k < std::min(h.first.size(), l.first.size()); ++k) {
         d += fmt::format("{}M_r ratio cycle {}: hill x{:.3f} vs linear x{:.3f}", d.empty() ? "" : "; ", k + 1, h.first[k], l.first[k]);
-        ok = ok && h.first[k] > l.first[k];
+        ok.add(h.first[k] > l.first[k]);
       }
       d += fmt::format("; peak-q ratio: hill x{:.3f} vs linear x{:.3f}", h.second, l.second);
       out.push_back("the C5b/C5n difference is larger for hill: " + d + " -> " + verdict(ok));
@@ -241,12 +253,12 @@ std::vector<std::string> StudyResult::findings() const {
     const CaseResult *w = find("C5b", GrainModel::Hill, true), *d = find("C5b", GrainModel::Hill, false);
     if (w && d) {
       std::string detail;
-      bool ok = true;
+      Tally ok;
       for (std::size_t k = 0; k < std::min(w->test.loops.size(), d->test.loops.size()); ++k) {
         const double a = w->test.loops[k].unload_secant, b = d->test.loops[k].unload_secant;
         detail += fmt::format("{}cycle {}: wet {:.1f} vs dry {:.1f} MPa (x{:.2f})", detail.empty() ? "" : "; ", k + 1, a / 1e6, b / 1e6,
                               b > 0 ? a / b : 0.0);
-        ok = ok && a > b;
+        ok.add(a > b);
       }
       out.push_back("wet C5b hill has a higher resilient modulus than dry: " + detail + " -> " + verdict(ok));
     }
