@@ -192,7 +192,7 @@ TEST(Checkpoint, InvalidContentsWithValidChecksumsAreRefused) {
   refused("flag", [](Simulation& s) { s.contacts.exists[0] = 2; }, "neither 0 nor 1");
   refused("image", [](Simulation& s) { s.contacts.image[0] = 200; }, "image code");
   refused("column length", [](Simulation& s) { s.contacts.gap.pop_back(); }, "rows");
-  refused("position", [](Simulation& s) { s.balls.position[3].x = NAN; }, "position that is not finite");
+  refused("position", [](Simulation& s) { s.balls.position[3].x = NAN; }, "non-finite 'position'");
   refused("radius", [](Simulation& s) { s.balls.radius[3] = -1.0; }, "radius");
   refused("duplicate id", [](Simulation& s) { s.balls.id[3] = s.balls.id[4]; }, "appears twice");
   refused("fixity", [](Simulation& s) { s.balls.fixity[3] = 0xFF; }, "fixity");
@@ -202,6 +202,13 @@ TEST(Checkpoint, InvalidContentsWithValidChecksumsAreRefused) {
   refused("wall name", [](Simulation& s) { s.walls.walls[1].name = s.walls.walls[0].name; }, "used twice");
   refused("damping", [](Simulation& s) { s.settings.local_damping = 1.0; }, "local_damping");
   refused("clock", [](Simulation& s) { s.steps = -1; }, "out of range");
+  refused("ball force", [](Simulation& s) { s.balls.contact_force[2].y = NAN; }, "non-finite 'contact_force'");
+  refused("ball velocity", [](Simulation& s) { s.balls.velocity[2].z = INFINITY; }, "non-finite 'velocity'");
+  refused("contact force", [](Simulation& s) {
+    for (std::size_t c = 0; c < s.contacts.size(); ++c)
+      if (s.contacts.exists[c]) s.contacts.force[c].x = NAN;
+  }, "non-finite 'force'");
+  refused("wall velocity", [](Simulation& s) { s.walls.walls[3].velocity.x = NAN; }, "non-finite position, velocity or force");
 }
 
 TEST(Checkpoint, WritesAreAtomic) {

@@ -1,11 +1,14 @@
 // The malformed-checkpoint corpus (tests/data/bad_checkpoints/, made by make_corpus.py): resuming
-// from any of its files is an InputError whose message starts with the file's path — never a crash,
-// never another exception.
+// from any of its files is an InputError whose message starts with the file's path and gives the
+// reason expected.txt names for it — never a crash, never another exception. (When the format
+// changes, regenerate the corpus: a stale file would be refused for the wrong reason.)
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
+#include <fstream>
+#include <map>
 #include <sstream>
 #include <unistd.h>
 
@@ -26,7 +29,22 @@ std::vector<std::string> corpus() {
   return names;
 }
 
-TEST(BadCheckpointCorpus, HasAtLeast30Files) { EXPECT_GE(corpus().size(), 30u); }
+std::map<std::string, std::string> expected_reasons() {
+  std::map<std::string, std::string> m;
+  std::ifstream in(corpus_dir() / "expected.txt");
+  std::string line;
+  while (std::getline(in, line)) {
+    const auto colon = line.find(": ");
+    if (colon != std::string::npos) m[line.substr(0, colon)] = line.substr(colon + 2);
+  }
+  return m;
+}
+
+TEST(BadCheckpointCorpus, HasAtLeast30FilesEachWithItsReason) {
+  EXPECT_GE(corpus().size(), 30u);
+  const auto reasons = expected_reasons();
+  for (const std::string& f : corpus()) EXPECT_TRUE(reasons.count(f)) << f << " has no line in expected.txt";
+}
 
 class BadCheckpoint : public ::testing::TestWithParam<std::string> {};
 
@@ -44,6 +62,9 @@ TEST_P(BadCheckpoint, ResumeRefusesItNamingTheFile) {
   } catch (const hilldem::InputError& e) {
     const std::string m = e.what();
     EXPECT_EQ(m.rfind(path + ": ", 0), 0u) << m;
+    const std::string reason = expected_reasons()[GetParam()];
+    EXPECT_FALSE(reason.empty());
+    EXPECT_NE(m.find(reason), std::string::npos) << "expected the reason '" << reason << "', got: " << m;
   } catch (const std::exception& e) {
     ADD_FAILURE() << path << ": expected hilldem::InputError, got: " << e.what();
   }

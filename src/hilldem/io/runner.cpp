@@ -728,13 +728,16 @@ void restore_scenario(const CheckpointReader& r, Scenario& sc) {
   const std::string file = s.str(1u << 20);
   const std::string text = s.str();
   s.finish();
+  // The state first: its size bounds the scenario's (a damaged text cannot ask for millions of balls).
+  Simulation restored;
+  read_simulation(r, restored, true);
   try {
-    sc = load_scenario(text, file);
+    ScenarioLimits limits;
+    limits.max_balls = std::max<std::uint64_t>(restored.balls.size(), 1);
+    sc = load_scenario(text, file, limits);
   } catch (const InputError& e) {
     throw InputError(r.source() + ": the scenario it carries does not load: " + e.what());
   }
-  Simulation restored;
-  read_simulation(r, restored, true);
   // The stages refer to balls and walls by index and to groups by bit: they must be the scenario's.
   const Simulation& fresh = sc.sim;
   auto mismatch = [&](const std::string& what) {
@@ -802,15 +805,16 @@ std::string find_checkpoint(const std::string& path, std::ostream& log) {
   throw InputError(dir.string() + ": every checkpoint in this folder is damaged:" + errors);
 }
 
-RunResult resume_scenario(const std::string& path, Scenario& sc, const RunOptions& options, std::ostream& log) {
-  const std::string file = find_checkpoint(path, log);
-  const CheckpointReader r = CheckpointReader::from_file(file);
+namespace {
+
+RunResult resume_from(const CheckpointReader& r, Scenario& sc, const RunOptions& options, const std::string& dir,
+                      std::ostream& log) {
   {
     SectionReader meta = r.section(kMetaSection);
     const std::string kind = meta.str(4096);
     if (kind == "blow-up")
-      throw InputError(file + ": holds the state of a blow-up, for inspection (hilldem inspect); resume from the "
-                              "run's checkpoints/ folder instead");
+      throw InputError(r.source() + ": holds the state of a blow-up, for inspection (hilldem inspect); resume from the "
+                                    "run's checkpoints/ folder instead");
   }
   restore_scenario(r, sc);
   {
@@ -836,17 +840,33 @@ RunResult resume_scenario(const std::string& path, Scenario& sc, const RunOption
       s.fail("output settings out of range");
     c.keep = static_cast<int>(keep);
   }
+  Runner runner(sc, options, log);
+  return runner.resume(r, dir);
+}
+
+}  // namespace
+
+RunResult resume_scenario(const CheckpointReader& r, Scenario& sc, const RunOptions& options, std::ostream& log) {
+  return resume_from(r, sc, options, options.output_dir, log);
+}
+
+RunResult resume_scenario(const std::string& path, Scenario& sc, const RunOptions& options, std::ostream& log) {
+  const std::string file = find_checkpoint(path, log);
+  const CheckpointReader r = CheckpointReader::from_file(file);
   std::string dir = options.output_dir;
   if (dir.empty()) {
     const fs::path parent = fs::absolute(fs::path(file)).parent_path();
     dir = (parent.filename() == kCheckpointFolder ? parent.parent_path() : parent).string();
   }
-  Runner runner(sc, options, log);
-  return runner.resume(r, dir);
+  return resume_from(r, sc, options, dir, log);
 }
 
 std::string describe_checkpoint(const std::string& path, std::optional<std::int64_t> ball) {
-  const CheckpointReader r = CheckpointReader::from_file(path);
+  return describe_checkpoint(CheckpointReader::from_file(path), ball);
+}
+
+std::string describe_checkpoint(const CheckpointReader& r, std::optional<std::int64_t> ball) {
+  const std::string& path = r.source();
   std::string out = fmt::format("checkpoint {} (format version {})\n", path, kCheckpointFormatVersion);
   if (r.has(kMetaSection)) {
     SectionReader m = r.section(kMetaSection);

@@ -83,6 +83,8 @@ std::string find_checkpoint(const std::string& path, std::ostream& log);
 // folder (the parent of its checkpoints/ folder) unless options.output_dir is given. A corrupt,
 // truncated or mismatched checkpoint is an InputError naming the problem.
 RunResult resume_scenario(const std::string& path, Scenario& sc, const RunOptions& options, std::ostream& log);
+// The same from a checkpoint already read (outputs go to options.output_dir; none when it is empty).
+RunResult resume_scenario(const CheckpointReader& checkpoint, Scenario& sc, const RunOptions& options, std::ostream& log);
 
 // Value of a history or probe quantity: an engine quantity (io/quantity.hpp), or a servo.* quantity
 // of servo `servo` (>= 0).
@@ -98,5 +100,6 @@ std::string probe_table(const RunResult& result);
 // What a checkpoint holds, in words (hilldem inspect): its kind, clock, stage position, counts and
 // sections; with `ball`, that ball's state and every contact it has.
 std::string describe_checkpoint(const std::string& path, std::optional<std::int64_t> ball);
+std::string describe_checkpoint(const CheckpointReader& checkpoint, std::optional<std::int64_t> ball);
 
 }  // namespace hilldem

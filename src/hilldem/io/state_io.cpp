@@ -1,6 +1,7 @@
 #include "hilldem/io/state_io.hpp"
 
 #include <cmath>
+#include <cstring>
 #include <fmt/format.h>
 #include <set>
 #include <type_traits>
@@ -233,6 +234,28 @@ ModelRule read_rule(SectionReader& r) {
 
 bool finite3(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
+// Every floating-point number of a value is finite (doubles, Vec3 and the structs of doubles the stores
+// hold); integers and enums always are. A saved state is never non-finite: the runner stops a run
+// before it gets there (blow-up detection), so a non-finite value means a damaged file.
+template <class T>
+bool all_finite(const T& v) {
+  if constexpr (std::is_floating_point_v<T>) {
+    return std::isfinite(v);
+  } else if constexpr (std::is_same_v<T, Vec3>) {
+    return finite3(v);
+  } else if constexpr (std::is_same_v<T, HillParams> || std::is_same_v<T, HillMapping> || std::is_same_v<T, LinearParams> ||
+                       std::is_same_v<T, LinearMapping>) {
+    static_assert(sizeof(T) % sizeof(double) == 0);
+    double d[sizeof(T) / sizeof(double)];
+    std::memcpy(d, &v, sizeof(T));
+    for (double x : d)
+      if (!std::isfinite(x)) return false;
+    return true;
+  } else {
+    return true;
+  }
+}
+
 // Column names for messages, in for_each_column / zip_columns order (a column the engine adds later
 // is still written and compared; only its message says "column N").
 constexpr const char* kBallColumns[] = {"id", "radius", "density", "mass", "inertia", "young_mod", "pois_ratio", "groups",
@@ -274,6 +297,14 @@ void check_contacts(SectionReader& r, const ContactStore& c, std::size_t n_balls
     if (c.model[i] == ModelKind::Hill && key.kind != ContactKind::BallBall) r.fail(row + ": a hill contact with a wall");
     if (static_cast<std::uint8_t>(c.moisture[i]) > 2) r.fail(row + " has an unknown moisture state");
   }
+  // Contacts hold finite numbers (rows that are only neighbour pairs may keep an infinite gap).
+  std::size_t column = 0;
+  ContactStore::zip_columns(c, c, [&](const auto& col, const auto&) {
+    for (std::size_t i = 0; i < n; ++i)
+      if (c.exists[i] && !all_finite(col[i]))
+        r.fail("contact row " + std::to_string(i) + " has a non-finite '" + column_name(kContactColumns, column) + "'");
+    ++column;
+  });
 }
 
 }  // namespace
@@ -373,6 +404,10 @@ void read_simulation(const CheckpointReader& cr, Simulation& out, bool prepare_t
     scratch.for_each_column([&](auto& col) {
       get_column(r, col, column_name(kBallColumns, k).c_str());
       if (col.size() != n) r.fail("ball column '" + column_name(kBallColumns, k) + "' has the wrong length");
+      for (std::size_t i = 0; i < col.size(); ++i)
+        if (!all_finite(col[i]))
+          r.fail("ball " + std::to_string(scratch.id.size() > i ? scratch.id[i] : 0) + " has a non-finite '" +
+                 column_name(kBallColumns, k) + "'");
       ++k;
     });
     r.finish();
@@ -388,7 +423,6 @@ void read_simulation(const CheckpointReader& cr, Simulation& out, bool prepare_t
       if (!(scratch.radius[i] > 0.0 && std::isfinite(scratch.radius[i]))) r.fail(ball + " has a radius that is not positive and finite");
       if (!(scratch.mass[i] > 0.0 && std::isfinite(scratch.mass[i]) && scratch.inertia[i] > 0.0 && std::isfinite(scratch.inertia[i])))
         r.fail(ball + " has a mass or inertia that is not positive and finite");
-      if (!finite3(scratch.position[i])) r.fail(ball + " has a position that is not finite");
       if (scratch.fixity[i] > kFixAll) r.fail(ball + " has fixity bits beyond the six components");
       if (scratch.groups[i] & ~known_groups) r.fail(ball + " is in a group that is not defined");
       BallInit b;
@@ -418,6 +452,12 @@ void read_simulation(const CheckpointReader& cr, Simulation& out, bool prepare_t
       Wall x = read_wall(r);
       if (x.name.empty() || !names.insert(x.name).second) r.fail("wall name '" + x.name + "' is empty or used twice");
       if (x.shape == WallShape::Cylinder && !(x.radius > 0.0)) r.fail("cylinder wall '" + x.name + "' has no positive radius");
+      const bool finite = finite3(x.point) && finite3(x.normal) && finite3(x.vertex[0]) && finite3(x.vertex[1]) &&
+                          finite3(x.vertex[2]) && std::isfinite(x.radius) && std::isfinite(x.lo) && std::isfinite(x.hi) &&
+                          finite3(x.velocity) && finite3(x.spin) && finite3(x.rotation_center) &&
+                          std::isfinite(x.radial_velocity) && finite3(x.force) && finite3(x.moment) &&
+                          std::isfinite(x.normal_force) && std::isfinite(x.normal_stiffness);
+      if (!finite) r.fail("wall '" + x.name + "' has a non-finite position, velocity or force");
       sim.walls.add(std::move(x));
     }
     r.finish();

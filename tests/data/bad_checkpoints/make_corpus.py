@@ -210,10 +210,41 @@ def main(src, out):
         struct.pack_into("<d", p, o, struct.unpack_from("<d", p, o)[0] + 1e-3)
     files["tampered_state_digest_mismatch.hdc"] = build(mutated(tampered_velocity))
 
+    def keep_zero(s):
+        p = section(s, "run.settings")[2]
+        # snapshots: 6 bytes of flags and a count, then the folder string; checkpoints: flag, i64, f64, flag, then keep.
+        folder, pos = string_at(p, 1 + 8 + 4)
+        struct.pack_into("<q", p, pos + 1 + 8 + 8 + 1, 0)
+    files["settings_keep_zero.hdc"] = build(mutated(keep_zero))
+
+    # What each refusal must say (tests/io/test_checkpoint_corpus.cpp checks it, so that a stale corpus
+    # cannot pass for the wrong reason).
+    expect = {
+        "empty.hdc": "empty file", "not_a_checkpoint.hdc": "not a hilldem checkpoint", "magic_only.hdc": "shorter than the header",
+        "truncated_header.hdc": "shorter than the header", "truncated_in_section.hdc": "truncated checkpoint",
+        "truncated_trailer.hdc": "truncated checkpoint", "trailing_garbage.hdc": "trailing data",
+        "bit_flip_in_payload.hdc": "fails its checksum", "bit_flip_in_header.hdc": "header checksum mismatch",
+        "bit_flip_in_trailer.hdc": "end marker", "future_format_version.hdc": "format version 2",
+        "zero_crc.hdc": "fails its checksum", "huge_body_size.hdc": "the header announces", "section_size_past_end.hdc": "runs past the end",
+        "missing_contacts_section.hdc": "no section 'sim.contacts'", "missing_position_section.hdc": "no section 'run.position'",
+        "duplicate_section.hdc": "appears twice", "newer_section_version.hdc": "has version 99",
+        "contact_key_out_of_range.hdc": "refers to ball index", "contact_kind_bad.hdc": "has kind 7",
+        "ball_radius_negative.hdc": "radius that is not positive", "ball_position_nan.hdc": "non-finite 'position'",
+        "ball_id_duplicate.hdc": "appears twice", "ball_column_element_size.hdc": "incompatible hilldem build",
+        "ball_count_huge.hdc": "exceeds the limit", "wall_count_huge.hdc": "exceeds the limit", "wall_axis_bad.hdc": "has axis 9",
+        "settings_damping_out_of_range.hdc": "local_damping", "clock_negative_steps.hdc": "out of range",
+        "group_count_65.hdc": "exceeds the limit 64", "scenario_not_toml.hdc": "TOML syntax error",
+        "scenario_mismatch.hdc": "does not match its scenario", "position_stage_past_end.hdc": "stage 1000 of a scenario",
+        "position_steps_past_stage.hdc": "steps done inside a stage", "servo_name_mismatch.hdc": "is not the scenario's servo",
+        "snapshot_count_huge.hdc": "exceeds the limit", "blowup_state_not_resumable.hdc": "state of a blow-up",
+        "tampered_state_digest_mismatch.hdc": "differs from the saved", "settings_keep_zero.hdc": "output settings out of range",
+    }
+    assert set(expect) == set(files), set(files) ^ set(expect)
     out.mkdir(parents=True, exist_ok=True)
     for name, content in sorted(files.items()):
         (out / name).write_bytes(content)
-    print(f"wrote {len(files)} files to {out}")
+    (out / "expected.txt").write_text("".join(f"{name}: {expect[name]}\n" for name in sorted(files)))
+    print(f"wrote {len(files)} files and expected.txt to {out}")
 
 
 if __name__ == "__main__":
