@@ -331,14 +331,7 @@ class Runner {
       for (ScenarioServo& sv : sc_.servos) {
         const std::string name = s.str(4096);
         if (name != sv.name) s.fail("servo '" + name + "' is not the scenario's servo '" + sv.name + "'");
-        sv.servo.settings.target_stress = s.f64();
-        sv.servo.settings.gain_factor = s.f64();
-        sv.servo.settings.max_speed = s.f64();
-        sv.servo.enabled = s.boolean();
-        s.f64();  // the speed it last imposed (informational: recomputed at the start of every cycle)
-        if (!std::isfinite(sv.servo.settings.target_stress) || !(sv.servo.settings.gain_factor > 0.0) ||
-            !(sv.servo.settings.gain_factor <= 1.0) || !(sv.servo.settings.max_speed > 0.0))
-          s.fail("servo '" + name + "' has settings out of range");
+        read_servo(s, sv.servo);
       }
       s.finish();
     }
@@ -475,11 +468,7 @@ class Runner {
       s.u64(sc_.servos.size());
       for (const ScenarioServo& sv : sc_.servos) {
         s.str(sv.name);
-        s.f64(sv.servo.settings.target_stress);
-        s.f64(sv.servo.settings.gain_factor);
-        s.f64(sv.servo.settings.max_speed);
-        s.boolean(sv.servo.enabled);
-        s.f64(sv.servo.speed());
+        write_servo(s, sv.servo);
       }
     }
     write_simulation(w, sim_);

@@ -89,7 +89,7 @@ struct CheckpointSettings {
 
 // Limits that keep hostile or mistaken input from exhausting memory.
 struct ScenarioLimits {
-  std::uint64_t max_balls = 10'000'000;
+  std::uint64_t max_balls = 50'000'000;  // as the reader's own guard
 };
 
 struct Scenario {

@@ -505,6 +505,28 @@ void read_simulation(const CheckpointReader& cr, Simulation& out, bool prepare_t
   out = std::move(sim);
 }
 
+void write_servo(SectionWriter& w, const Servo& servo) {
+  w.f64(servo.settings.target_stress);
+  w.f64(servo.settings.gain_factor);
+  w.f64(servo.settings.max_speed);
+  w.boolean(servo.enabled);
+  w.f64(servo.speed());
+}
+
+void read_servo(SectionReader& r, Servo& servo) {
+  ServoSettings s;
+  s.target_stress = r.f64();
+  s.gain_factor = r.f64();
+  s.max_speed = r.f64();
+  const bool enabled = r.boolean();
+  r.f64();  // the last speed (informational)
+  if (!std::isfinite(s.target_stress) || !(s.gain_factor > 0.0 && s.gain_factor <= 1.0) ||
+      !(s.max_speed > 0.0 && std::isfinite(s.max_speed)))
+    r.fail("servo settings out of range (target stress finite, gain factor in (0, 1], max speed > 0)");
+  servo.settings = s;
+  servo.enabled = enabled;
+}
+
 namespace {
 
 struct Part {

@@ -23,6 +23,7 @@
 #include <cstdint>
 #include <string>
 
+#include "hilldem/control/servo.hpp"
 #include "hilldem/engine/simulation.hpp"
 #include "hilldem/io/checkpoint.hpp"
 
@@ -35,6 +36,12 @@ void write_simulation(CheckpointWriter& w, const Simulation& sim);
 // made ready so that the next cycle continues exactly; without it (inspection of a blown-up state)
 // nothing is recomputed.
 void read_simulation(const CheckpointReader& r, Simulation& sim, bool prepare_to_cycle = true);
+
+// A servo's state (control/servo.hpp): its settings and whether it is on; the speed it last imposed is
+// written for inspection (the servo recomputes it at the start of every cycle). For drivers that keep
+// servos of their own: one call per servo, in a section of theirs.
+void write_servo(SectionWriter& w, const Servo& servo);
+void read_servo(SectionReader& r, Servo& servo);  // validates the ranges (InputError)
 
 // Canonical bytes of the physical state: clock, settings, every ball column, every wall, and every
 // contact that exists (all columns; neighbour-only rows are bookkeeping and left out). Equal bytes
