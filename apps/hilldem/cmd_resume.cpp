@@ -24,12 +24,12 @@ Command add_resume_command(CLI::App& app) {
             opt.quiet = o->quiet;
             opt.output_dir = o->output;
             Scenario sc;
-            const RunResult res = resume_scenario(o->path, sc, opt, std::cerr);
-            if (!o->quiet) {
-              std::cout << "hilldem resume " << o->path << (sc.title.empty() ? "" : ": " + sc.title) << "\n";
+            if (!o->quiet) std::cout << "hilldem resume " << o->path << "\n";
+            const RunResult res = resume_scenario(o->path, sc, opt, std::cout);
+            if (!o->quiet)
               std::cout << (res.already_complete ? "the run had already finished; nothing to do\n"
-                                                 : "resumed run finished at step " + std::to_string(sc.sim.steps) + "\n");
-            }
+                                                 : "finished at step " + std::to_string(sc.sim.steps) +
+                                                       (sc.title.empty() ? "" : ": " + sc.title) + "\n");
             std::cout << probe_table(res);
             if (!res.history_path.empty()) std::cout << "history: " << res.history_path << "\n";
             return 0;

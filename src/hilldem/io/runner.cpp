@@ -829,8 +829,18 @@ RunResult resume_from(const CheckpointReader& r, Scenario& sc, const RunOptions&
       s.fail("output settings out of range");
     c.keep = static_cast<int>(keep);
   }
+  if (!options.quiet) {
+    SectionReader p = r.section("run.position");
+    const std::uint64_t stage = p.u64();
+    const std::int64_t steps = p.i64();
+    log << fmt::format("resuming from {} (step {}, t = {:.6g} s, stage {} of {}, {} steps into it)\n", r.source(),
+                       sc.sim.steps, sc.sim.time, std::min<std::uint64_t>(stage + 1, sc.stages.size()), sc.stages.size(),
+                       steps);
+  }
   Runner runner(sc, options, log);
-  return runner.resume(r, dir);
+  RunResult result = runner.resume(r, dir);
+  result.resumed_from = r.source();
+  return result;
 }
 
 }  // namespace

@@ -51,6 +51,7 @@ struct RunResult {
   std::string last_checkpoint;  // the newest checkpoint file written ("" when none)
   bool halted = false;          // RunOptions::halt_after_step was reached
   bool already_complete = false;  // resume_scenario found a finished run
+  std::string resumed_from;       // resume_scenario: the checkpoint it continued from
   const ProbeValue* find(const std::string& label) const;
 };
 
