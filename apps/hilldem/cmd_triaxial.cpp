@@ -37,13 +37,13 @@ struct Options {
   double pressure = 150e3;
   std::vector<double> cycles{0.02, 0.05};  // [%]
   double final_strain = 1.0;                // [%]
-  double strain_rate = 0.0;                 // [1/s], 0: default
-  double final_strain_rate = 0.0;
+  double strain_rate = TriaxialSettings{}.strain_rate;              // [1/s]
+  double final_strain_rate = TriaxialSettings{}.final_strain_rate;  // [1/s]
   double unload_to = 0.1;
   double suction = 20e3;
   double moisture_gap = 3e-3;
   double d_mult = 1.0;
-  double finalize_ratio = 0.0;
+  double finalize_ratio = EquilibriumSettings{}.ratio;
   std::string specimen;
   bool no_plot = false;
   bool pack_only = false;
@@ -71,15 +71,16 @@ std::pair<StudySettings, std::vector<CaseSpec>> build(const Options& o) {
   if (!(o.pressure > 0)) throw InputError(fmt::format("--pressure must be > 0 Pa, got {:g}", o.pressure));
   s.genesis.packing.equilibrium.pressure = o.pressure;
   s.finalize = s.genesis.packing.equilibrium;
-  if (o.finalize_ratio > 0) s.finalize.ratio = o.finalize_ratio;
+  s.finalize.ratio = o.finalize_ratio;  // validated with the rest
   s.triaxial.confinement = o.pressure;
   s.triaxial.cycle_strains.clear();
   for (double c : o.cycles) s.triaxial.cycle_strains.push_back(c / 100.0);
   s.triaxial.final_strain = o.final_strain / 100.0;
-  if (o.strain_rate > 0) s.triaxial.strain_rate = o.strain_rate;
-  else if (o.strain_rate < 0) throw InputError(fmt::format("--strain-rate must be > 0 1/s, got {:g}", o.strain_rate));
-  if (o.final_strain_rate > 0) s.triaxial.final_strain_rate = o.final_strain_rate;
-  else if (o.final_strain_rate < 0) throw InputError(fmt::format("--final-strain-rate must be > 0 1/s, got {:g}", o.final_strain_rate));
+  if (!(o.strain_rate > 0)) throw InputError(fmt::format("--strain-rate must be > 0 1/s, got {:g}", o.strain_rate));
+  if (!(o.final_strain_rate > 0))
+    throw InputError(fmt::format("--final-strain-rate must be > 0 1/s, got {:g}", o.final_strain_rate));
+  s.triaxial.strain_rate = o.strain_rate;
+  s.triaxial.final_strain_rate = o.final_strain_rate;
   s.triaxial.unload_fraction = o.unload_to;
   s.suction = o.suction;
   s.moisture_gap = o.moisture_gap;

@@ -86,6 +86,8 @@ Specimen parse_packed_specimen(const std::string& text, const std::string& sourc
     std::string c;
     while (std::getline(ss, c, ',')) cells.push_back(trim(c));
     if (!header) {
+      if (keys.empty() && cells[0] != "format")
+        throw fail(lineno, fmt::format("not a hilldem specimen file: the first line must be `format,{},{}`", kMagic, kVersion));
       if (cells.size() >= 1 && cells[0] == "id") {
         header = true;
         if (cells.size() != 8) throw fail(lineno, "expected the header id,x[m],y[m],z[m],radius[m],density[kg/m3],young_mod[Pa],pois_ratio[-]");
