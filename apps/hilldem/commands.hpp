@@ -22,7 +22,5 @@ Command add_resume_command(CLI::App& app);   // continue a run from a checkpoint
 Command add_inspect_command(CLI::App& app);  // describe a checkpoint
 Command add_run_output_options(CLI::App& app);  // snapshot/checkpoint options of `run` (after add_scenario_commands)
 Command add_triaxial_command(CLI::App& app);  // material genesis and triaxial tests (labtests/)
-Command add_resume_command(CLI::App& app);   // continue a run from a checkpoint
-Command add_inspect_command(CLI::App& app);  // describe a checkpoint
 
 }  // namespace hilldem::cli

@@ -18,8 +18,6 @@ int main(int argc, char** argv) {
   commands.push_back(add_inspect_command(app));
   commands.push_back(add_run_output_options(app));
   commands.push_back(add_triaxial_command(app));
-  commands.push_back(add_resume_command(app));
-  commands.push_back(add_inspect_command(app));
 
   try {
     app.parse(argc, argv);
