@@ -251,7 +251,7 @@ PhaseReport relax_cloud(Specimen& s, const PackingSettings& p, std::ostream* log
   for (Vec3& v : sim.balls.velocity) v = Vec3{};
   for (Vec3& w : sim.balls.spin) w = Vec3{};
   PhaseReport r{"cloud", sim.steps - start, seconds_since(t0), measure(s)};
-  if (log) *log << r.line() << "\n";
+  if (log) *log << r.line() << std::endl;
   s.phases.push_back(r);
   return r;
 }
@@ -291,7 +291,7 @@ PhaseReport servo_equilibrium(Specimen& s, const EquilibriumSettings& e, const s
   }
   s.vessel.stop(sim);
   PhaseReport r{name, sim.steps - start, seconds_since(t0), measure(s)};
-  if (log) *log << r.line() << "\n";
+  if (log) *log << r.line() << std::endl;
   s.phases.push_back(r);
   return r;
 }

@@ -331,7 +331,7 @@ StudyResult run_study(const StudySettings& settings, const std::vector<CaseSpec>
   StudyResult study;
   for (const CaseSpec& c : cases) {
     const std::string gname = resolve_grading(c.grading).name;
-    if (log) *log << fmt::format("\n=== {} ===\n", c.name());
+    if (log) *log << fmt::format("\n=== {} ===\n", c.name()) << std::flush;
     auto it = packed.find(gname);
     if (it == packed.end()) it = packed.emplace(gname, make_packed(settings, c.grading, settings.save_specimens, log)).first;
     const auto tc = std::chrono::steady_clock::now();

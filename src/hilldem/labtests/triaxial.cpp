@@ -207,6 +207,11 @@ TriaxialResult run_triaxial(Specimen& s, const TriaxialSettings& t, std::ostream
     if (force_record || std::abs(r.eps_a - last_rec_eps) >= rec) record(r);
     force_record = false;
 
+    if (log && r.step % 20000 == 0) {
+      *log << fmt::format("  {:>6} step {:>8}: eps_a {:.4f} %  q {:.2f} kPa  sigma_r {:.2f} kPa  dt {:.3g} s\n", to_string(phase),
+                          r.step, 100 * r.eps_a, r.q / 1e3, r.sigma_r / 1e3, sim.last_dt);
+      log->flush();
+    }
     // Phase changes, decided on this cycle's state; the row of the turning point is always recorded.
     TriaxialPhase next = phase;
     if (phase == TriaxialPhase::Load && r.eps_a >= t.cycle_strains[k]) {
@@ -227,6 +232,7 @@ TriaxialResult run_triaxial(Specimen& s, const TriaxialSettings& t, std::ostream
       if (log)
         *log << fmt::format("  {:>6} {}: eps_a {:.5f} %  q {:.2f} kPa  sigma_r {:.2f} kPa  step {}\n", to_string(phase),
                             cycle, 100 * r.eps_a, r.q / 1e3, r.sigma_r / 1e3, r.step);
+      if (log) log->flush();
       phase = next;
     }
     if (sim.steps - step0 >= t.max_steps) {
