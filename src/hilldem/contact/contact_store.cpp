@@ -20,11 +20,9 @@ void ContactStore::append_new(const ContactKey& k, ImageCode img, int rule_index
   normal.push_back(n);
   moisture.push_back(Moisture::Dry);  // new contacts start dry (spec §2.5)
   gap.push_back(0.0);
-  torque.emplace_back();
   force.emplace_back();
   normal_force.push_back(0.0);
   moisture_force.push_back(0.0);
-  shear_force.emplace_back();
   trial_shear.push_back(0.0);
   active.push_back(0);
   k_tran.push_back(0.0);

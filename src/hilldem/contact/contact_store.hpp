@@ -46,17 +46,18 @@ class ContactStore {
 
   // History carried between steps
   std::vector<Vec3> shear_state;    // linear: F_s; hill: F^h_s [N], in the plane of `normal`
-  std::vector<Vec3> shear_disp;     // accumulated relative shear displacement Σ Δδ_s [m], same plane
+  std::vector<Vec3> shear_disp;     // accumulated relative shear displacement Σ Δδ_s [m], same plane; kept
+                                    // only while SimulationSettings::track_shear_displacement is on
   std::vector<Vec3> normal;         // n̂_c of the last step
   std::vector<Moisture> moisture;   // hill M
 
   // Results of the last force-displacement pass
+  // Only what the cycle needs is stored (each column costs memory traffic on every step): the shear
+  // force and the moment are derived from these (shear_force(), and n̂_c × F_c in collect_forces()).
   std::vector<double> gap;             // g_c [m]
-  std::vector<Vec3> torque;            // n̂_c × F_c [N]: the moment on ball b is −(R_b + g_c/2)·torque
-  std::vector<Vec3> force;             // F_c on piece 2 [N]
+  std::vector<Vec3> force;             // F_c = (F_n + F^m) n̂_c + F_s on piece 2 [N]
   std::vector<double> normal_force;    // F_n (linear) or F^s_n (hill) [N], compression positive
   std::vector<double> moisture_force;  // F^m [N] ≤ 0
-  std::vector<Vec3> shear_force;       // F_s [N]
   std::vector<double> trial_shear;     // |F*_s| [N]
   std::vector<std::uint8_t> active;
   std::vector<double> k_tran;          // k̂_n + k̂_s [N/m] for the time step (0 if inactive)
@@ -72,9 +73,9 @@ class ContactStore {
     f(self.linear_map, other.linear_map); f(self.hill_map, other.hill_map);
     f(self.shear_state, other.shear_state); f(self.shear_disp, other.shear_disp);
     f(self.normal, other.normal); f(self.moisture, other.moisture);
-    f(self.gap, other.gap); f(self.torque, other.torque); f(self.force, other.force);
+    f(self.gap, other.gap); f(self.force, other.force);
     f(self.normal_force, other.normal_force); f(self.moisture_force, other.moisture_force);
-    f(self.shear_force, other.shear_force); f(self.trial_shear, other.trial_shear);
+    f(self.trial_shear, other.trial_shear);
     f(self.active, other.active); f(self.k_tran, other.k_tran); f(self.k_shear, other.k_shear);
   }
 
@@ -96,10 +97,12 @@ class ContactStore {
   void remove(std::size_t i) {
     exists[i] = 0;
     active[i] = 0;
-    shear_state[i] = shear_disp[i] = force[i] = shear_force[i] = torque[i] = Vec3{};
+    shear_state[i] = shear_disp[i] = force[i] = Vec3{};
     normal_force[i] = moisture_force[i] = trial_shear[i] = k_tran[i] = k_shear[i] = 0.0;
     moisture[i] = Moisture::Dry;
   }
+  // F_s [N] of row i: F_c less its normal part (exact zero when the shear force is zero).
+  Vec3 shear_force(std::size_t i) const { return force[i] - normal[i] * (normal_force[i] + moisture_force[i]); }
   std::size_t count_existing() const;
   void clear() {
     zip_columns(*this, *this, [](auto& dst, auto&) { dst.clear(); });

@@ -131,6 +131,17 @@ void Simulation::compute_mapping(ContactStore& store, std::size_t c) const {
   }
 }
 
+void Simulation::create_contact(std::size_t c, const Vec3& normal) {
+  // A new contact takes its properties from its assignment rule, as a row new to the neighbour list
+  // does: what an earlier contact of the same pair was given (make_wet's suction, a set_contact
+  // stage) is gone with it, and the result does not depend on when the list was rebuilt.
+  const ModelRule& rule = table.rules[static_cast<std::size_t>(contacts.rule[c])];
+  if (contacts.model[c] == ModelKind::Hill) contacts.hill_params[c] = rule.hill;
+  else contacts.linear_params[c] = rule.linear;
+  compute_mapping(contacts, c);
+  contacts.create(c, normal);
+}
+
 void Simulation::refresh_mappings() {
   for (std::size_t c = 0; c < contacts.size(); ++c) compute_mapping(contacts, c);
 }
@@ -152,7 +163,10 @@ void Simulation::rebuild_if_needed() {
   if (!rebuild_needed_ && position_at_build_.size() == balls.size()) {
     const double half = 0.5 * skin();
     double worst = 0.0;
-    for (std::size_t i = 0; i < balls.size(); ++i) worst = std::max(worst, norm2(balls.position[i] - position_at_build_[i]));
+    for (std::size_t i = 0; i < balls.size(); ++i) {
+      const double d2 = norm2(balls.position[i] - position_at_build_[i]);
+      if (!(d2 <= worst)) worst = d2;  // not std::max, which would drop a NaN
+    }
     if (!std::isfinite(worst)) {
       for (std::size_t i = 0; i < balls.size(); ++i)
         if (!std::isfinite(norm2(balls.position[i])))
@@ -280,7 +294,7 @@ bool Simulation::force_row(std::size_t c, double dt) {
     gap = touch ? touch->gap : std::numeric_limits<double>::infinity();
     if (!contacts.exists[c] && gap > proximity) return true;
   }
-  if (!contacts.exists[c]) contacts.create(c, normal);  // created by proximity
+  if (!contacts.exists[c]) create_contact(c, normal);  // created by proximity
   const double arm1 = r1 + 0.5 * gap;                   // |x_c − x_1|
   const Vec3 point = x1 + normal * arm1;                // x_c, centre of the gap/overlap
 
@@ -297,7 +311,7 @@ bool Simulation::force_row(std::size_t c, double dt) {
   const PlaneRotation rotation(contacts.normal[c], normal, 0.5 * dot(balls.spin[a] + spin2, normal), dt);
   const ContactKinematics kin{normal, gap, v2 - v1, dt};
 
-  Vec3 force, shear;
+  Vec3 force;
   double fn = 0.0, fm = 0.0, trial = 0.0;
   bool active = false;
   StiffnessEstimate stiff;
@@ -307,14 +321,14 @@ bool Simulation::force_row(std::size_t c, double dt) {
     const HillResult r = hill_force(contacts.hill_params[c], contacts.hill_map[c], kin, prev);
     contacts.shear_state[c] = r.state.shear_hm;
     moisture = r.state.moisture;
-    force = r.force, shear = r.shear_force, fn = r.surface_normal, fm = r.moisture_force;
+    force = r.force, fn = r.surface_normal, fm = r.moisture_force;
     trial = r.trial_shear, active = r.active;
     if (active && want_stiffness) stiff = hill_timestep_stiffness(contacts.hill_params[c], contacts.hill_map[c], gap);
   } else {
     const LinearState prev{rotation.carry(contacts.shear_state[c])};
     const LinearResult r = linear_force(contacts.linear_params[c], contacts.linear_map[c], kin, prev);
     contacts.shear_state[c] = r.state.shear_force;
-    force = r.force, shear = r.shear_force, fn = r.normal_force, trial = r.trial_shear, active = r.active;
+    force = r.force, fn = r.normal_force, trial = r.trial_shear, active = r.active;
     if (active) stiff = {contacts.linear_map[c].kn, contacts.linear_map[c].ks};
   }
   // Deleted when inactive beyond the proximity distance (a wet contact stays active: spec §2.5).
@@ -325,14 +339,14 @@ bool Simulation::force_row(std::size_t c, double dt) {
     return true;
   }
   // Accumulated shear displacement (reported, not used by the laws): rotated with the plane.
-  contacts.shear_disp[c] = active ? rotation.rotate(contacts.shear_disp[c]) + kin.shear_rate() * dt : Vec3{};
+  if (settings.track_shear_displacement)
+    contacts.shear_disp[c] = active ? rotation.rotate(contacts.shear_disp[c]) + kin.shear_rate() * dt : Vec3{};
+  // Only the columns the cycle needs (memory traffic): F_s = F_c − (F_n + F^m) n̂ is derived.
   contacts.normal[c] = normal;
   contacts.gap[c] = gap;
   contacts.force[c] = active ? force : Vec3{};
-  contacts.torque[c] = active ? cross(normal, force) : Vec3{};
   contacts.normal_force[c] = fn;
   contacts.moisture_force[c] = fm;
-  contacts.shear_force[c] = shear;
   contacts.trial_shear[c] = trial;
   contacts.k_tran[c] = stiff.kn + stiff.ks;
   contacts.k_shear[c] = stiff.ks;
@@ -376,9 +390,10 @@ void Simulation::collect_forces() {
       const std::int64_t code = ball_rows_[k];
       const std::size_t c = static_cast<std::size_t>(code > 0 ? code - 1 : -code - 1);
       if (!contacts.active[c]) continue;
-      if (code > 0) f += contacts.force[c];
-      else f -= contacts.force[c];
-      m -= contacts.torque[c] * (r + 0.5 * contacts.gap[c]);
+      const Vec3 fc = contacts.force[c];
+      if (code > 0) f += fc;
+      else f -= fc;
+      m -= cross(contacts.normal[c], fc) * (r + 0.5 * contacts.gap[c]);
     }
     balls.contact_force[i] = f;
     balls.contact_moment[i] = m;
@@ -449,7 +464,7 @@ double Simulation::mean_unbalanced_ratio() const {
       // Magnitudes of the parts, not of their sum: a wet contact in equilibrium carries a Hertz force
       // and an equal and opposite moisture force, and its net force is zero.
       const double fn = contacts.normal_force[c];
-      contact += std::sqrt(fn * fn + norm2(contacts.shear_force[c])) + std::abs(contacts.moisture_force[c]);
+      contact += std::sqrt(fn * fn + norm2(contacts.shear_force(c))) + std::abs(contacts.moisture_force[c]);
       ++active;
     }
   unbalanced /= static_cast<double>(free_balls);
@@ -465,7 +480,7 @@ std::size_t Simulation::make_wet(double suction, double gap) {
     if (contacts.model[c] != ModelKind::Hill) continue;
     const ContactGeometry g = geometry(c);
     if (g.gap <= gap) {  // steps 2-3: a contact (new ones start here), suction, then make_wet(g_m)
-      if (!contacts.exists[c]) contacts.create(c, g.normal);
+      if (!contacts.exists[c]) create_contact(c, g.normal);
       contacts.hill_params[c].suction = suction;
       contacts.moisture[c] = Moisture::Wet;
     }

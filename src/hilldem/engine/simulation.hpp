@@ -35,6 +35,9 @@ struct SimulationSettings {
   // what that Δt needs for stability, m' = max(m, k_tran (Δt/f)²), I' = max(I, k_rot (Δt/f)²).
   // Static equilibria are unchanged; dynamics are not physical. For quasi-static runs only.
   bool density_scaling = false;
+  // Accumulate each contact's relative shear displacement (ContactStore::shear_disp). A reported
+  // quantity that no law uses: off by default, on when a scenario records contact.shear_disp.
+  bool track_shear_displacement = false;
   PeriodicBox box;               // periodic directions and their period [lo, hi) [m]
 };
 
@@ -121,6 +124,8 @@ class Simulation {
   bool force_row(std::size_t c, double dt);
   void collect_forces();
   void compute_mapping(ContactStore& store, std::size_t c) const;
+  // Row c becomes a contact (created by proximity) with its rule's properties.
+  void create_contact(std::size_t c, const Vec3& normal);
   // Σ over ball i's active contacts: k_tran = Σ(k̂_n + k̂_s) [N/m], k_rot = Σ k̂_s |x_c − x|² [N m].
   void ball_stiffness(std::size_t i, double& k_tran, double& k_rot) const;
   std::uint64_t piece2_groups(const ContactKey& k) const;

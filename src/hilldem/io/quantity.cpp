@@ -168,14 +168,14 @@ double contact_value(const Simulation& s, long c, const std::string& f) {
   if (f == "overlap") return -k.gap[c];
   if (f == "normal_force") return k.normal_force[c];
   if (f == "moisture_force") return k.moisture_force[c];
-  if (f == "shear_force") return norm(k.shear_force[c]);
+  if (f == "shear_force") return norm(k.shear_force(c));
   if (f == "trial_shear") return k.trial_shear[c];
   if (f == "shear_disp") return norm(k.shear_disp[c]);
   if (f == "kn") return hill ? h.kn : k.linear_map[c].kn;
   if (f == "ks") return hill ? h.ks : k.linear_map[c].ks;
   if (f == "fric_coef") return hill ? k.hill_params[c].fric_coef : k.linear_params[c].fric;
   if (f.rfind("force_", 0) == 0) return k.force[c][axis_of(f)];
-  if (f.rfind("shear_", 0) == 0 && f.size() == 7) return k.shear_force[c][axis_of(f)];
+  if (f.rfind("shear_", 0) == 0 && f.size() == 7) return k.shear_force(c)[axis_of(f)];
   if (!hill) return kNaN;  // the rest are hill quantities
   if (f == "bn") return h.bn;
   if (f == "bs") return h.bs;

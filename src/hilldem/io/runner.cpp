@@ -242,7 +242,7 @@ std::string ball_contacts_text(const Simulation& sim, std::size_t i, std::size_t
     }
     out += fmt::format("    {:<26} {:<6} {:<4} {:<6} gap {:>12.5g} m  normal {:>12.5g} N  shear {:>12.5g} N  moisture {:>12.5g} N\n",
                        pieces_text(sim, k), to_string(c.model[k]), moisture_text(c, k), c.active[k] ? "active" : "open",
-                       c.gap[k], c.normal_force[k], norm(c.shear_force[k]), c.moisture_force[k]);
+                       c.gap[k], c.normal_force[k], norm(c.shear_force(k)), c.moisture_force[k]);
   }
   return n == 0 ? "    (no contacts)\n" : out;
 }

@@ -559,6 +559,7 @@ class Reader {
       if (o.name == h.name) t.fail("name", "history \"" + h.name + "\" is defined twice");
     if (is_servo_quantity(t)) h.servo = read_servo_quantity(t, sc, h.quantity);
     else h.quantity = read_quantity(t, sc.sim);
+    if (h.quantity.field == "shear_disp") sc.sim.settings.track_shear_displacement = true;
     t.finish();
     sc.histories.push_back(h);
   }
@@ -668,6 +669,7 @@ class Reader {
       if (!labels_.insert(s.label).second) t.fail("label", "probe label \"" + s.label + "\" is used twice");
       if (is_servo_quantity(t)) s.servo = read_servo_quantity(t, sc, s.quantity);
       else s.quantity = read_quantity(t, sim);
+      if (s.quantity.field == "shear_disp") sc.sim.settings.track_shear_displacement = true;
       s.ratio_to = t.string("ratio_to", "");
       if (!s.ratio_to.empty() && (s.ratio_to == s.label || !labels_.count(s.ratio_to)))
         t.fail("ratio_to", "must name an earlier probe label; got \"" + s.ratio_to + "\"");

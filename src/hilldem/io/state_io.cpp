@@ -29,7 +29,7 @@ constexpr std::size_t initialisers() {
   else return N;
 }
 }  // namespace tripwire
-static_assert(tripwire::initialisers<SimulationSettings>() == 10, "SimulationSettings changed: update write_settings/read_settings in io/state_io.cpp");
+static_assert(tripwire::initialisers<SimulationSettings>() == 11, "SimulationSettings changed: update write_settings/read_settings in io/state_io.cpp");
 static_assert(tripwire::initialisers<Wall>() == 21, "Wall changed: update write_wall/read_wall in io/state_io.cpp");
 static_assert(tripwire::initialisers<ModelRule>() == 9, "ModelRule changed: update write_rule/read_rule in io/state_io.cpp");
 static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 changed: update io/state_io.cpp");
@@ -147,6 +147,7 @@ void write_settings(SectionWriter& w, const SimulationSettings& s) {
   w.f64(s.proximity);
   w.f64(s.skin);
   w.boolean(s.density_scaling);
+  w.boolean(s.track_shear_displacement);
   for (bool p : s.box.periodic) w.boolean(p);
   w.vec3(s.box.lo);
   w.vec3(s.box.hi);
@@ -163,6 +164,7 @@ SimulationSettings read_settings(SectionReader& r) {
   s.proximity = r.f64();
   s.skin = r.f64();
   s.density_scaling = r.boolean();
+  s.track_shear_displacement = r.boolean();
   for (bool& p : s.box.periodic) p = r.boolean();
   s.box.lo = r.vec3();
   s.box.hi = r.vec3();
@@ -263,7 +265,7 @@ constexpr const char* kBallColumns[] = {"id", "radius", "density", "mass", "iner
                                         "applied_force", "applied_moment"};
 constexpr const char* kContactColumns[] = {
     "key", "image", "exists", "rule", "model", "linear_params", "hill_params", "linear_map", "hill_map", "shear_state",
-    "shear_disp", "normal", "moisture", "gap", "torque", "force", "normal_force", "moisture_force", "shear_force",
+    "shear_disp", "normal", "moisture", "gap", "force", "normal_force", "moisture_force",
     "trial_shear", "active", "k_tran", "k_shear"};
 
 template <std::size_t N>

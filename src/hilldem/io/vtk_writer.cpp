@@ -272,8 +272,8 @@ void write_contacts_vtp(const Simulation& sim, const std::string& path, bool bin
     normal.push_back(c.normal[k]);
     fn.push_back(c.normal_force[k]);
     fm.push_back(c.moisture_force[k]);
-    fs.push_back(c.shear_force[k]);
-    fs_mag.push_back(norm(c.shear_force[k]));
+    fs.push_back(c.shear_force(k));
+    fs_mag.push_back(norm(c.shear_force(k)));
     force.push_back(c.force[k]);
     point.push_back(xc);
     suction.push_back(hill ? c.hill_params[k].suction : 0.0);
