@@ -39,6 +39,7 @@ struct Options {
   double final_strain = 1.0;                // [%]
   double strain_rate = TriaxialSettings{}.strain_rate;              // [1/s]
   double final_strain_rate = TriaxialSettings{}.final_strain_rate;  // [1/s]
+  double density_scaling = 0.0;                                     // F [-]
   double unload_to = 0.1;
   double suction = 20e3;
   double moisture_gap = 3e-3;
@@ -81,6 +82,7 @@ std::pair<StudySettings, std::vector<CaseSpec>> build(const Options& o) {
     throw InputError(fmt::format("--final-strain-rate must be > 0 1/s, got {:g}", o.final_strain_rate));
   s.triaxial.strain_rate = o.strain_rate;
   s.triaxial.final_strain_rate = o.final_strain_rate;
+  s.triaxial.density_scaling = o.density_scaling;  // validated with the rest
   s.triaxial.unload_fraction = o.unload_to;
   s.suction = o.suction;
   s.moisture_gap = o.moisture_gap;
@@ -193,6 +195,9 @@ Command add_triaxial_command(CLI::App& app) {
   cmd->add_option("--final-strain", o->final_strain, "final axial strain [%] (default 1)");
   cmd->add_option("--strain-rate", o->strain_rate, "axial strain rate during the cycles [1/s] (default 0.02)");
   cmd->add_option("--final-strain-rate", o->final_strain_rate, "axial strain rate after the cycles [1/s] (default 0.1)");
+  cmd->add_option("--density-scaling", o->density_scaling,
+                  "triaxial tests with a fixed time step F times the automatic one and density scaling: F times "
+                  "fewer steps (0 = off, the default; or 1 to 50)");
   cmd->add_option("--unload-to", o->unload_to, "unload until q falls to this fraction of q at the reversal (default 0.1)");
   cmd->add_option("--suction", o->suction, "suction of make_wet [Pa] (default 20e3)");
   cmd->add_option("--moisture-gap", o->moisture_gap, "moisture gap of make_wet [m] (default 3e-3)");

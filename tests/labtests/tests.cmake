@@ -39,6 +39,9 @@ add_test(NAME cli.triaxial_bad_grading_file_exits_2
 add_test(NAME cli.triaxial_missing_specimen_exits_2
   COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "cannot open the specimen file"
           2 $<TARGET_FILE:hilldem> triaxial --specimen ${HILLDEM_TEST_DATA}/labtests/no_such_specimen.csv -o ${HILLDEM_TRIAXIAL_OUT}/bad8)
+add_test(NAME cli.triaxial_bad_density_scaling_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "density scaling factor must be 0 (off) or in [1, 50], got 0.5" --not-stdout "cloud"
+          2 $<TARGET_FILE:hilldem> triaxial --density-scaling 0.5 -o ${HILLDEM_TRIAXIAL_OUT}/bad9)
 # A refused run creates no output folder.
 add_test(NAME cli.triaxial_refused_run_writes_nothing
   COMMAND bash -c "rm -rf \"$1\"; \"$0\" triaxial --cycles 0.05,0.02 -o \"$1\" 2>/dev/null; test $? -eq 2 && test ! -e \"$1\""
@@ -53,7 +56,7 @@ add_test(NAME cli.triaxial_miniature_case_exits_0
 set_tests_properties(cli.triaxial_unknown_grading_exits_2 cli.triaxial_negative_pressure_exits_2
   cli.triaxial_cycles_out_of_order_exits_2 cli.triaxial_final_below_cycles_exits_2 cli.triaxial_wet_linear_exits_2
   cli.triaxial_unknown_material_exits_2 cli.triaxial_bad_grading_file_exits_2 cli.triaxial_missing_specimen_exits_2
-  cli.triaxial_miniature_case_exits_0 cli.triaxial_refused_run_writes_nothing
+  cli.triaxial_miniature_case_exits_0 cli.triaxial_refused_run_writes_nothing cli.triaxial_bad_density_scaling_exits_2
   PROPERTIES TIMEOUT 120 LABELS "cli;labtests")
 # The figures script on that run's output (Debian's python3 with python3-matplotlib, from scripts/setup.sh).
 add_test(NAME cli.triaxial_plot_script_writes_figures

@@ -50,6 +50,8 @@ void validate(const TriaxialSettings& t) {
     throw bad("cycle record strain", t.cycle_record_strain, ">= 0");
   if (t.final_records < 1) throw bad("final records", t.final_records, ">= 1");
   if (t.max_steps < 1) throw bad("max steps", static_cast<double>(t.max_steps), ">= 1");
+  if (!(t.density_scaling == 0 || (t.density_scaling >= 1 && t.density_scaling <= 50)))
+    throw bad("density scaling factor", t.density_scaling, "0 (off) or in [1, 50]");
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -132,6 +134,25 @@ TriaxialResult run_triaxial(Specimen& s, const TriaxialSettings& t, std::ostream
   const double r0 = res.radius0 = v.radius(sim);
   const double time0 = sim.time;
   const std::int64_t step0 = sim.steps;
+
+  // Density scaling for the test only: the settings are restored when it ends (or throws).
+  struct SettingsScope {
+    Simulation& sim;
+    SimulationSettings saved;
+    bool active;
+    ~SettingsScope() {
+      if (active) sim.settings = saved;
+    }
+  } settings_scope{sim, sim.settings, t.density_scaling > 0};
+  if (t.density_scaling > 0) {
+    sim.update_forces();
+    const double dt = t.density_scaling * sim.next_timestep();
+    sim.settings.auto_timestep = false;
+    sim.settings.timestep = dt;
+    sim.settings.density_scaling = true;
+    if (log) *log << fmt::format("triaxial: density scaling, fixed time step {:.4g} s ({:g} x the automatic one)\n", dt,
+                                 t.density_scaling);
+  }
 
   auto servo = std::make_shared<Servo>(v.radial_servo(ServoSettings{t.confinement, t.servo_gain, t.wall_speed_limit}));
   auto closing = std::make_shared<double>(0.0);  // each platen's speed towards the other [m/s]

@@ -25,6 +25,10 @@ struct TriaxialSettings {
   double wall_speed_limit = 1.0;                // radial servo speed cap [m/s]
   double cycle_record_strain = 0.0;             // history row every this much ε_a in the cycles [-]; 0: 1/100 of the first cycle strain
   int final_records = 500;                      // history rows of the final loading
+  // Density scaling (docs/performance.md): 0 = off (automatic Δt, real masses); F ≥ 1: a fixed
+  // Δt = F × the automatic Δt at the start of the test, each grain's inertia raised as that Δt needs.
+  // F times fewer steps at the same strain rate; the grains respond as under an F times faster load.
+  double density_scaling = 0.0;                 // F [-], 0 or [1, 50]
   std::int64_t max_steps = 100'000'000;
 };
 // Throws InputError naming the first bad value (before any work).
