@@ -232,7 +232,14 @@ void Simulation::rebuild(double proximity) {
   }
   while (o < contacts.size()) keep_old_if_needed(o++);
   contacts = std::move(next);
+  build_row_lists();
+  position_at_build_ = balls.position;
+  wall_travel_ = 0.0;
+  rebuild_needed_ = false;
+  ++rebuilds_;
+}
 
+void Simulation::build_row_lists() {
   // Per-ball row lists (CSR), in row order: the fixed summation order of collect_forces().
   const std::size_t n = balls.size();
   ball_rows_start_.assign(n + 1, 0);
@@ -252,10 +259,27 @@ void Simulation::rebuild(double proximity) {
     ball_rows_[fill[k.a]++] = -row;
     if (k.kind == ContactKind::BallBall) ball_rows_[fill[k.b]++] = row;
   }
-  position_at_build_ = balls.position;
-  wall_travel_ = 0.0;
-  rebuild_needed_ = false;
-  ++rebuilds_;
+}
+
+CycleState Simulation::cycle_state() const {
+  return {forces_ready_, rebuild_needed_, rebuilds_, unassigned_pairs_, position_at_build_, wall_travel_};
+}
+
+void Simulation::restore_cycle_state(CycleState s) {
+  if (!s.position_at_build.empty() && s.position_at_build.size() != balls.size())
+    throw RunError("cycle state for " + std::to_string(s.position_at_build.size()) + " balls, the simulation has " +
+                   std::to_string(balls.size()));
+  for (const ContactKey& k : contacts.key)
+    if (k.a >= balls.size() || (k.kind == ContactKind::BallBall && k.b >= balls.size()) ||
+        (k.kind == ContactKind::BallWall && k.b >= walls.size()))
+      throw RunError("cycle state: a contact row refers to a body that does not exist");
+  forces_ready_ = s.forces_ready;
+  rebuild_needed_ = s.rebuild_needed || s.position_at_build.empty();
+  rebuilds_ = s.rebuilds;
+  unassigned_pairs_ = static_cast<std::size_t>(s.unassigned_pairs);
+  position_at_build_ = std::move(s.position_at_build);
+  wall_travel_ = s.wall_travel;
+  build_row_lists();
 }
 
 // One row, any model and kind (the general path). Returns false on a non-finite force.

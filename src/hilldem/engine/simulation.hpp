@@ -49,6 +49,18 @@ struct ContactGeometry {
   bool valid = true;  // false: a ball beyond a cylinder's end (no contact possible)
 };
 
+// The cycle's private bookkeeping, for checkpoints: with it a restored run rebuilds its neighbour
+// list at the very steps the saved run would have (which matters with periodic boxes, where the
+// rebuild wraps positions into the box).
+struct CycleState {
+  bool forces_ready = false;
+  bool rebuild_needed = true;
+  std::int64_t rebuilds = 0;
+  std::uint64_t unassigned_pairs = 0;
+  std::vector<Vec3> position_at_build;  // [m] ball positions at the last rebuild
+  double wall_travel = 0.0;             // [m] bound on wall motion since then
+};
+
 class Simulation {
  public:
   BallStore balls;
@@ -108,6 +120,12 @@ class Simulation {
   // Detect contacts and compute forces at the current state with no motion (Δt = 0 increments).
   void update_forces();
 
+  CycleState cycle_state() const;
+  // Put back a saved CycleState, with the contact rows and ball columns it was saved with: the per-ball
+  // row lists are rebuilt from the current rows (no detection, no merge). Throws RunError if the
+  // state does not fit the balls.
+  void restore_cycle_state(CycleState s);
+
   ContactGeometry geometry(std::size_t c) const;
   // Contact between balls with user ids, or between a ball and a wall (index); -1 if none.
   long find_ball_ball(std::int64_t id1, std::int64_t id2) const;
@@ -118,6 +136,7 @@ class Simulation {
  private:
   void step_once();
   void rebuild(double reach);
+  void build_row_lists();  // per-ball row lists (CSR) and wall rows from the current rows
   void rebuild_if_needed();
   void force_pass(double dt);
   // The force-displacement law of one row (any model and kind); false on a non-finite force.

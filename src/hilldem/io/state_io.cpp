@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <fmt/format.h>
 #include <set>
 #include <type_traits>
@@ -352,6 +353,17 @@ void write_simulation(CheckpointWriter& w, const Simulation& sim) {
     ContactStore::zip_columns(sim.contacts, sim.contacts, [&](const auto& col, const auto&) { put_column(s, col); });
   }
   {
+    // The cycle's bookkeeping: the restored run rebuilds its neighbour list when this one would have.
+    SectionWriter& s = w.section("sim.cycle");
+    const CycleState cs = sim.cycle_state();
+    s.boolean(cs.forces_ready);
+    s.boolean(cs.rebuild_needed);
+    s.i64(cs.rebuilds);
+    s.u64(cs.unassigned_pairs);
+    put_column(s, cs.position_at_build);
+    s.f64(cs.wall_travel);
+  }
+  {
     SectionWriter& s = w.section("sim.info");
     s.i64(sim.rebuilds());
     s.u64(sim.unassigned_pairs());
@@ -479,8 +491,37 @@ void read_simulation(const CheckpointReader& cr, Simulation& out, bool prepare_t
     check_contacts(r, sim.contacts, sim.balls.size(), sim.walls.size(), sim.table.rules.size());
   }
 
-  if (prepare_to_cycle) {
-    // Detect contacts and compute forces once (this marks the forces as ready and builds the
+  std::optional<CycleState> cycle;
+  if (cr.has("sim.cycle")) {
+    SectionReader r = cr.section("sim.cycle");
+    CycleState cs;
+    cs.forces_ready = r.boolean();
+    cs.rebuild_needed = r.boolean();
+    cs.rebuilds = r.i64();
+    cs.unassigned_pairs = r.u64();
+    get_column(r, cs.position_at_build, "position_at_build");
+    cs.wall_travel = r.f64();
+    r.finish();
+    if (cs.rebuilds < 0) r.fail("negative rebuild count " + std::to_string(cs.rebuilds));
+    if (!cs.position_at_build.empty() && cs.position_at_build.size() != sim.balls.size())
+      r.fail("positions at the last rebuild for " + std::to_string(cs.position_at_build.size()) + " balls, the state has " +
+             std::to_string(sim.balls.size()));
+    for (const Vec3& x : cs.position_at_build)
+      if (!finite3(x)) r.fail("a non-finite position at the last rebuild");
+    if (!(cs.wall_travel >= 0) || !std::isfinite(cs.wall_travel)) r.fail("wall travel must be finite and >= 0");
+    cycle = std::move(cs);
+  }
+
+  if (prepare_to_cycle && cycle) {
+    // Exact: the saved rows, ball columns and walls as they are, the row lists rebuilt from the rows,
+    // and the next rebuild at the step the saved run would have made it.
+    try {
+      sim.restore_cycle_state(std::move(*cycle));
+    } catch (const RunError& e) {
+      throw InputError(cr.source() + ": the saved state cannot be cycled: " + e.what());
+    }
+  } else if (prepare_to_cycle) {
+    // A checkpoint without the cycle section (written before it existed). Detect contacts and compute forces once (this marks the forces as ready and builds the
     // per-ball row lists), then put back everything saved: the restored rows by key, the balls, the
     // walls' sums.
     const BallStore balls = sim.balls;
