@@ -372,8 +372,10 @@ bool Simulation::force_row(std::size_t c, double dt) {
   contacts.normal_force[c] = fn;
   contacts.moisture_force[c] = fm;
   contacts.trial_shear[c] = trial;
-  contacts.k_tran[c] = stiff.kn + stiff.ks;
-  contacts.k_shear[c] = stiff.ks;
+  if (want_stiffness) {  // only the time-step estimate and density scaling read them
+    contacts.k_tran[c] = stiff.kn + stiff.ks;
+    contacts.k_shear[c] = stiff.ks;
+  }
   // Byte-sized columns last: a char store may alias anything, so the compiler reloads every
   // column pointer after one.
   contacts.moisture[c] = moisture;
