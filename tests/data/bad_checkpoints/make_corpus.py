@@ -217,6 +217,25 @@ def main(src, out):
         struct.pack_into("<q", p, pos + 1 + 8 + 8 + 1, 0)
     files["settings_keep_zero.hdc"] = build(mutated(keep_zero))
 
+    # sim.cycle: forces_ready u8, rebuild_needed u8, rebuilds i64, unassigned u64, positions column
+    # (u64 count, u32 element size, data), wall travel f64.
+    def cycle_rebuilds_negative(s):
+        struct.pack_into("<q", section(s, "sim.cycle")[2], 2, -5)
+    files["cycle_rebuilds_negative.hdc"] = build(mutated(cycle_rebuilds_negative))
+
+    def cycle_wall_travel_nan(s):
+        p = section(s, "sim.cycle")[2]
+        struct.pack_into("<d", p, len(p) - 8, float("nan"))
+    files["cycle_wall_travel_nan.hdc"] = build(mutated(cycle_wall_travel_nan))
+
+    def cycle_positions_for_other_balls(s):
+        p = section(s, "sim.cycle")[2]
+        n, size = struct.unpack_from("<QI", p, 18)
+        # one ball fewer: drop its element and lower the count
+        del p[18 + 12 + (n - 1) * size : 18 + 12 + n * size]
+        struct.pack_into("<Q", p, 18, n - 1)
+    files["cycle_positions_for_other_balls.hdc"] = build(mutated(cycle_positions_for_other_balls))
+
     # What each refusal must say (tests/io/test_checkpoint_corpus.cpp checks it, so that a stale corpus
     # cannot pass for the wrong reason).
     expect = {
@@ -238,6 +257,8 @@ def main(src, out):
         "position_steps_past_stage.hdc": "steps done inside a stage", "servo_name_mismatch.hdc": "is not the scenario's servo",
         "snapshot_count_huge.hdc": "exceeds the limit", "blowup_state_not_resumable.hdc": "state of a blow-up",
         "tampered_state_digest_mismatch.hdc": "differs from the saved", "settings_keep_zero.hdc": "output settings out of range",
+        "cycle_rebuilds_negative.hdc": "negative rebuild count", "cycle_wall_travel_nan.hdc": "wall travel must be finite",
+        "cycle_positions_for_other_balls.hdc": "positions at the last rebuild for 2 balls",
     }
     assert set(expect) == set(files), set(files) ^ set(expect)
     out.mkdir(parents=True, exist_ok=True)
