@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <random>
 
 #include "hilldem/engine/simulation.hpp"
@@ -41,6 +42,24 @@ inline ModelRule linear_wall_rule(double emod, double fric) {
   r.model = ModelKind::Linear;
   r.linear = {emod, 1.0, fric};
   return r;
+}
+
+// Granite balls of radius 5 mm in a row on the x axis, separated by the given gaps [m], with the
+// hill model (μ 0.4, no damping, no suction in the rule) and a fixed Δt of 1e-6 s; no contacts yet.
+inline Simulation granite_row(std::initializer_list<double> gaps) {
+  Simulation sim;
+  const double r = 5e-3;
+  double x = 0.0;
+  std::int64_t id = 1;
+  sim.balls.add(granite(id++, {x, 0, 0}, r));
+  for (double g : gaps) {
+    x += 2 * r + g;
+    sim.balls.add(granite(id++, {x, 0, 0}, r));
+  }
+  sim.table.rules.push_back(hill_rule(0.4, 0.0));
+  sim.settings.auto_timestep = false;
+  sim.settings.timestep = 1e-6;
+  return sim;
 }
 
 // A random cloud of n balls (radii 2-3 mm, scaled to fit) in a cube of side `side` [m] whose overlaps

@@ -17,13 +17,7 @@ using namespace hilldem::testing;
 
 // Two granite balls (R = 5 mm) 1 mm apart on the x axis, hill model without suction in the rule.
 Simulation pair_apart() {
-  Simulation sim;
-  const double r = 5e-3;
-  sim.balls.add(granite(1, {0, 0, 0}, r));
-  sim.balls.add(granite(2, {2 * r + 1e-3, 0, 0}, r));
-  sim.table.rules.push_back(hill_rule(0.4, 0.0));
-  sim.settings.auto_timestep = false;
-  sim.settings.timestep = 1e-6;
+  Simulation sim = granite_row({1e-3});
   sim.settings.skin = 3e-3;  // the pair stays on the neighbour list throughout
   return sim;
 }

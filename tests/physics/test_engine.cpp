@@ -14,17 +14,7 @@ namespace {
 using namespace hilldem::testing;
 
 // Three balls in a row with gaps 1 mm and 3 mm; no contacts exist before make_wet.
-Simulation three_in_a_row() {
-  Simulation sim;
-  const double r = 5e-3;
-  sim.balls.add(granite(1, {0, 0, 0}, r));
-  sim.balls.add(granite(2, {2 * r + 1e-3, 0, 0}, r));
-  sim.balls.add(granite(3, {4 * r + 4e-3, 0, 0}, r));
-  sim.table.rules.push_back(hill_rule(0.4, 0.0));
-  sim.settings.auto_timestep = false;
-  sim.settings.timestep = 1e-6;
-  return sim;
-}
+Simulation three_in_a_row() { return granite_row({1e-3, 3e-3}); }
 
 TEST(MakeWet, CreatesContactsWithinTheGapOnly) {
   Simulation sim = three_in_a_row();

@@ -521,9 +521,9 @@ void read_simulation(const CheckpointReader& cr, Simulation& out, bool prepare_t
       throw InputError(cr.source() + ": the saved state cannot be cycled: " + e.what());
     }
   } else if (prepare_to_cycle) {
-    // A checkpoint without the cycle section (written before it existed). Detect contacts and compute forces once (this marks the forces as ready and builds the
-    // per-ball row lists), then put back everything saved: the restored rows by key, the balls, the
-    // walls' sums.
+    // A checkpoint without the cycle section (written before it existed). Detect contacts and
+    // compute forces once (this marks the forces as ready and builds the per-ball row lists), then
+    // put back everything saved: the restored rows by key, the balls, the walls' sums.
     const BallStore balls = sim.balls;
     const WallStore walls = sim.walls;
     const ContactStore saved = sim.contacts;
