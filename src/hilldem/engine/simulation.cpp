@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <numeric>
 #include <sstream>
 
 #include "hilldem/contact/cell_grid.hpp"
 #include "hilldem/core/error.hpp"
+#include "hilldem/engine/hill_batch.hpp"
 
 namespace hilldem {
 
@@ -240,25 +242,50 @@ void Simulation::rebuild(double proximity) {
 }
 
 void Simulation::build_row_lists() {
-  // Per-ball row lists (CSR), in row order: the fixed summation order of collect_forces().
+  // Per-ball row lists (CSR), in row order: the fixed summation order of ball_stiffness().
   const std::size_t n = balls.size();
+  const std::size_t rows = contacts.size();
+  if (rows > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
+    throw RunError("too many neighbour pairs (" + std::to_string(rows) + ") for one process");
   ball_rows_start_.assign(n + 1, 0);
+  first_rows_.assign(n + 1, 0);
+  late_rows_start_.assign(n + 1, 0);
   wall_rows_.clear();
-  for (std::size_t c = 0; c < contacts.size(); ++c) {
+  for (std::size_t c = 0; c < rows; ++c) {
     const ContactKey& k = contacts.key[c];
     ++ball_rows_start_[k.a + 1];
-    if (k.kind == ContactKind::BallBall) ++ball_rows_start_[k.b + 1];
-    else wall_rows_.push_back(static_cast<std::uint32_t>(c));
+    if (k.kind == ContactKind::BallBall) {
+      ++ball_rows_start_[k.b + 1];
+      ++first_rows_[k.a + 1];
+      ++late_rows_start_[k.b + 1];
+    } else {
+      wall_rows_.push_back(static_cast<std::uint32_t>(c));
+      ++late_rows_start_[k.a + 1];
+    }
   }
-  for (std::size_t i = 0; i < n; ++i) ball_rows_start_[i + 1] += ball_rows_start_[i];
+  for (std::size_t i = 0; i < n; ++i) {
+    ball_rows_start_[i + 1] += ball_rows_start_[i];
+    first_rows_[i + 1] += first_rows_[i];
+    late_rows_start_[i + 1] += late_rows_start_[i];
+  }
   ball_rows_.assign(ball_rows_start_[n], 0);
+  late_rows_.assign(late_rows_start_[n], 0);
   std::vector<std::uint32_t> fill(ball_rows_start_.begin(), ball_rows_start_.end() - 1);
-  for (std::size_t c = 0; c < contacts.size(); ++c) {
+  std::vector<std::uint32_t> late_fill(late_rows_start_.begin(), late_rows_start_.end() - 1);
+  for (std::size_t c = 0; c < rows; ++c) {
     const ContactKey& k = contacts.key[c];
     const auto row = static_cast<std::int64_t>(c) + 1;
     ball_rows_[fill[k.a]++] = -row;
-    if (k.kind == ContactKind::BallBall) ball_rows_[fill[k.b]++] = row;
+    if (k.kind == ContactKind::BallBall) {
+      ball_rows_[fill[k.b]++] = row;
+      late_rows_[late_fill[k.b]++] = static_cast<std::int32_t>(row);
+    } else {
+      late_rows_[late_fill[k.a]++] = static_cast<std::int32_t>(-row);
+    }
   }
+  share_moment_.assign(rows, Vec3{});
+  first_force_.assign(n, Vec3{});
+  first_moment_.assign(n, Vec3{});
 }
 
 CycleState Simulation::cycle_state() const {
@@ -282,8 +309,8 @@ void Simulation::restore_cycle_state(CycleState s) {
   build_row_lists();
 }
 
-// One row, any model and kind (the general path). Returns false on a non-finite force.
-bool Simulation::force_row(std::size_t c, double dt) {
+// One row, any model and kind (the general path).
+Simulation::RowShare Simulation::force_row(std::size_t c, double dt) {
   const double proximity = settings.proximity;
   const bool want_stiffness = settings.auto_timestep || settings.density_scaling;
   const PeriodicBox& box = settings.box;
@@ -306,17 +333,17 @@ bool Simulation::force_row(std::size_t c, double dt) {
     const double rsum = r1 + rad[key.b];
     if (!contacts.exists[c]) {
       const double reach = rsum + proximity;
-      if (dist2 > reach * reach) return true;  // a neighbour pair, not a contact
+      if (dist2 > reach * reach) return {};  // a neighbour pair, not a contact
     }
     const double dist = std::sqrt(dist2);
     normal = dist > 0.0 ? d / dist : contacts.normal[c];  // coincident centres: keep the old normal
     gap = dist - rsum;
   } else {
     const auto touch = wall_touch(walls.walls[key.b], x1, r1);
-    if (!touch && !contacts.exists[c]) return true;
+    if (!touch && !contacts.exists[c]) return {};
     normal = touch ? touch->normal : contacts.normal[c];
     gap = touch ? touch->gap : std::numeric_limits<double>::infinity();
-    if (!contacts.exists[c] && gap > proximity) return true;
+    if (!contacts.exists[c] && gap > proximity) return {};
   }
   if (!contacts.exists[c]) create_contact(c, normal);  // created by proximity
   const double arm1 = r1 + 0.5 * gap;                   // |x_c − x_1|
@@ -360,15 +387,22 @@ bool Simulation::force_row(std::size_t c, double dt) {
     contacts.remove(c);  // (moisture back to dry)
     contacts.gap[c] = gap;
     contacts.normal[c] = normal;
-    return true;
+    share_moment_[c] = Vec3{};
+    return {};
   }
   // Accumulated shear displacement (reported, not used by the laws): rotated with the plane.
   if (settings.track_shear_displacement)
     contacts.shear_disp[c] = active ? rotation.rotate(contacts.shear_disp[c]) + kin.shear_rate() * dt : Vec3{};
   // Only the columns the cycle needs (memory traffic): F_s = F_c − (F_n + F^m) n̂ is derived.
+  if (!active) force = Vec3{};
+  // Force on piece 2 is F_c, on piece 1 −F_c (spec conventions). The contact point lies on the normal
+  // at R + g/2 from either centre, so the moment on either ball is −(R + g/2) n̂ × F_c.
+  const Vec3 torque = cross(normal, force);
+  RowShare share{-force, torque * -arm1, true};
+  share_moment_[c] = ball2 ? torque * -(rad[key.b] + 0.5 * gap) : share.moment;
   contacts.normal[c] = normal;
   contacts.gap[c] = gap;
-  contacts.force[c] = active ? force : Vec3{};
+  contacts.force[c] = force;
   contacts.normal_force[c] = fn;
   contacts.moisture_force[c] = fm;
   contacts.trial_shear[c] = trial;
@@ -380,17 +414,156 @@ bool Simulation::force_row(std::size_t c, double dt) {
   // column pointer after one.
   contacts.moisture[c] = moisture;
   contacts.active[c] = active;
-  return std::isfinite(force.x + force.y + force.z);
+  share.ok = std::isfinite(force.x + force.y + force.z);
+  return share;
+}
+
+void Simulation::force_block(std::size_t a0, std::size_t a1, double dt, HillBatch& batch,
+                             std::vector<RowShare>& shares, std::size_t& bad_row, std::int64_t& batched_count) {
+  // Rows of balls a0..a1-1 (ball-ball rows, contiguous). Existing hill contacts go through the batch;
+  // new contacts, other models and the shear-displacement tracking through force_row().
+  const std::size_t r0 = first_rows_[a0], r1 = first_rows_[a1];
+  const double proximity = settings.proximity;
+  const bool want_stiffness = settings.auto_timestep || settings.density_scaling;
+  const bool batched = use_batched_kernel && !settings.track_shear_displacement;
+  const PeriodicBox& box = settings.box;
+  const BallKin* kin = ball_kin_.data();
+  const ContactKey* keys = contacts.key.data();
+  shares.assign(r1 - r0, RowShare{});
+  batch.clear();
+  using F = HillBatch;
+  auto put3 = [&batch](F::Field f, std::size_t lane, const Vec3& v) {
+    batch.col(f)[lane] = v.x;
+    batch.col(static_cast<F::Field>(f + 1))[lane] = v.y;
+    batch.col(static_cast<F::Field>(f + 2))[lane] = v.z;
+  };
+  auto get3 = [&batch](F::Field f, std::size_t lane) {
+    return Vec3{batch.col(f)[lane], batch.col(static_cast<F::Field>(f + 1))[lane],
+                batch.col(static_cast<F::Field>(f + 2))[lane]};
+  };
+  // The law of the gathered lanes, and their results into the rows.
+  auto flush = [&]() {
+    hill_batch_forces(batch, dt, want_stiffness);
+    batched_count += static_cast<std::int64_t>(batch.size());
+    for (std::size_t lane = 0; lane < batch.size(); ++lane) {
+      const std::size_t c = batch.row(lane);
+      const Vec3 normal = get3(F::kNx, lane);
+      const double g = batch.col(F::kGap)[lane];
+      const bool active = batch.col(F::kActive)[lane] != 0.0;
+      if (!active && g > proximity) {  // deleted when inactive beyond proximity (§2.5)
+        contacts.remove(c);
+        contacts.gap[c] = g;
+        contacts.normal[c] = normal;
+        share_moment_[c] = Vec3{};
+        continue;
+      }
+      const Vec3 force = get3(F::kFx, lane), torque = get3(F::kTx, lane);
+      const double half_gap = 0.5 * g;
+      RowShare& share = shares[c - r0];
+      share = RowShare{-force, torque * -(batch.col(F::kR1)[lane] + half_gap), std::isfinite(force.x + force.y + force.z)};
+      if (!share.ok) bad_row = std::min(bad_row, c);
+      share_moment_[c] = torque * -(batch.col(F::kR2)[lane] + half_gap);
+      contacts.shear_state[c] = get3(F::kShx, lane);
+      contacts.normal[c] = normal;
+      contacts.gap[c] = g;
+      contacts.force[c] = force;
+      contacts.normal_force[c] = batch.col(F::kFn)[lane];
+      contacts.moisture_force[c] = batch.col(F::kFm)[lane];
+      contacts.trial_shear[c] = batch.col(F::kTrial)[lane];
+      if (want_stiffness) {
+        contacts.k_tran[c] = batch.col(F::kKtran)[lane];
+        contacts.k_shear[c] = batch.col(F::kKshear)[lane];
+      }
+      if (batch.col(F::kRuptured)[lane] != 0.0) contacts.moisture[c] = Moisture::Ruptured;
+      contacts.active[c] = active;
+    }
+    batch.clear();
+  };
+  for (std::size_t a = a0; a < a1; ++a) {
+    const BallKin& ka = kin[a];
+    for (std::size_t c = first_rows_[a]; c < first_rows_[a + 1]; ++c) {
+      const std::size_t b = keys[c].b;
+      const BallKin& kb = kin[b];
+      Vec3 x2 = kb.position;
+      if (contacts.image[c] != kNoImage) x2 += image_shift(contacts.image[c], box);
+      const Vec3 d = x2 - ka.position;
+      const bool exists = contacts.exists[c];
+      if (!exists && batched) {  // a neighbour pair: a contact only once within proximity (as force_row)
+        const double reach = ka.radius + kb.radius + proximity;
+        if (norm2(d) > reach * reach) continue;
+      }
+      if (!batched || !exists || contacts.model[c] != ModelKind::Hill) {
+        shares[c - r0] = force_row(c, dt);
+        if (!shares[c - r0].ok) bad_row = std::min(bad_row, c);
+        continue;
+      }
+      if (batch.full()) flush();
+      const std::size_t lane = batch.add(static_cast<std::uint32_t>(c));
+      put3(F::kDx, lane, d);
+      batch.col(F::kR1)[lane] = ka.radius;
+      batch.col(F::kR2)[lane] = kb.radius;
+      put3(F::kVax, lane, ka.velocity);
+      put3(F::kVbx, lane, kb.velocity);
+      put3(F::kWax, lane, ka.spin);
+      put3(F::kWbx, lane, kb.spin);
+      put3(F::kNox, lane, contacts.normal[c]);
+      put3(F::kSx, lane, contacts.shear_state[c]);
+      batch.col(F::kIr1)[lane] = ka.terms.inv_radius, batch.col(F::kIm1)[lane] = ka.terms.inv_mass;
+      batch.col(F::kCn1)[lane] = ka.terms.normal, batch.col(F::kCs1)[lane] = ka.terms.shear;
+      batch.col(F::kIr2)[lane] = kb.terms.inv_radius, batch.col(F::kIm2)[lane] = kb.terms.inv_mass;
+      batch.col(F::kCn2)[lane] = kb.terms.normal, batch.col(F::kCs2)[lane] = kb.terms.shear;
+      const HillParams& p = contacts.hill_params[c];
+      batch.col(F::kFric)[lane] = p.fric_coef, batch.col(F::kSuction)[lane] = p.suction;
+      batch.col(F::kDamp)[lane] = p.damp_con;
+      batch.col(F::kWet)[lane] = contacts.moisture[c] == Moisture::Wet ? 1.0 : 0.0;
+    }
+  }
+  if (batch.size() > 0) flush();
+  // Ball a's half of the force sum, its rows in row order.
+  for (std::size_t a = a0; a < a1; ++a) {
+    Vec3 f, m;
+    for (std::size_t c = first_rows_[a]; c < first_rows_[a + 1]; ++c) {
+      f += shares[c - r0].force;
+      m += shares[c - r0].moment;
+    }
+    first_force_[a] = f;
+    first_moment_[a] = m;
+  }
 }
 
 void Simulation::force_pass(double dt) {
   const std::size_t rows = contacts.size();
-  // Each row writes only its own columns; the first failing row is found by a min-reduction, so
-  // the outcome does not depend on the thread count.
+  const std::size_t n = balls.size();
+  // Blocks of balls, each with its own rows (ball-ball rows are sorted by their first ball); each
+  // row writes only its own columns. The first failing row is found by a min-reduction, so the
+  // outcome does not depend on the thread count.
+  constexpr std::size_t kBlock = 32;
+  const std::size_t blocks = (n + kBlock - 1) / kBlock;
   std::size_t bad_row = rows;
-#pragma omp parallel for schedule(static) reduction(min : bad_row) if (rows > kParallelMin)
-  for (std::size_t c = 0; c < rows; ++c)
-    if (!force_row(c, dt)) bad_row = std::min(bad_row, c);
+  std::int64_t batched = 0;
+  ball_kin_.resize(n);
+#pragma omp parallel reduction(min : bad_row) reduction(+ : batched) if (n > kParallelMin)
+  {
+    // What the pair loop reads of each ball, in one record (two cache lines): one memory stream per
+    // neighbourhood instead of one per column. The hill terms from the current properties (real
+    // masses, §2.4).
+#pragma omp for schedule(static)
+    for (std::size_t i = 0; i < n; ++i)
+      ball_kin_[i] = {balls.position[i], balls.radius[i], balls.velocity[i], balls.spin[i],
+                    hill_body_terms(balls.radius[i], balls.young_mod[i], balls.pois_ratio[i], balls.mass[i])};
+    auto batch = std::make_unique<HillBatch>();  // ≈ 30 kB: on the heap, not the thread's stack
+    std::vector<RowShare> shares;
+#pragma omp for schedule(static)
+    for (std::size_t k = 0; k < blocks; ++k)
+      force_block(k * kBlock, std::min(n, (k + 1) * kBlock), dt, *batch, shares, bad_row, batched);
+  }
+  batched_rows_ = batched;
+  const std::size_t wall_rows = wall_rows_.size();
+#pragma omp parallel for schedule(static) reduction(min : bad_row) if (wall_rows > kParallelMin)
+  for (std::size_t k = 0; k < wall_rows; ++k) {
+    const std::size_t c = wall_rows_[k];
+    if (!force_row(c, dt).ok) bad_row = std::min(bad_row, c);
+  }
   if (bad_row < rows) {
     const ContactKey& key = contacts.key[bad_row];
     std::ostringstream msg;
@@ -404,22 +577,20 @@ void Simulation::force_pass(double dt) {
 }
 
 void Simulation::collect_forces() {
-  // Force on piece 2 is F_c, on piece 1 it is −F_c (spec conventions). The contact point lies on
-  // the normal at R + g/2 from either centre, so the moment on either ball is −(R + g/2) n̂ × F_c.
-  // Each ball sums its own rows in row order: the same result for any number of threads.
+  // Each ball adds, to the pair loop's half, its late rows in row order: the same result for any
+  // number of threads. Rows that are not active contacts hold zero force and moment.
   const std::size_t n = balls.size();
+  const Vec3* force = contacts.force.data();
+  const Vec3* moment = share_moment_.data();
 #pragma omp parallel for schedule(static) if (n > kParallelMin)
   for (std::size_t i = 0; i < n; ++i) {
-    Vec3 f, m;
-    const double r = balls.radius[i];
-    for (std::uint32_t k = ball_rows_start_[i]; k < ball_rows_start_[i + 1]; ++k) {
-      const std::int64_t code = ball_rows_[k];
+    Vec3 f = first_force_[i], m = first_moment_[i];
+    for (std::uint32_t k = late_rows_start_[i]; k < late_rows_start_[i + 1]; ++k) {
+      const std::int32_t code = late_rows_[k];
       const std::size_t c = static_cast<std::size_t>(code > 0 ? code - 1 : -code - 1);
-      if (!contacts.active[c]) continue;
-      const Vec3 fc = contacts.force[c];
-      if (code > 0) f += fc;
-      else f -= fc;
-      m -= cross(contacts.normal[c], fc) * (r + 0.5 * contacts.gap[c]);
+      if (code > 0) f += force[c];
+      else f -= force[c];
+      m += moment[c];
     }
     balls.contact_force[i] = f;
     balls.contact_moment[i] = m;

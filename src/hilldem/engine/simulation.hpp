@@ -17,6 +17,7 @@
 #include "hilldem/bodies/ball_store.hpp"
 #include "hilldem/bodies/wall_store.hpp"
 #include "hilldem/contact/contact_store.hpp"
+#include "hilldem/engine/hill_batch.hpp"
 #include "hilldem/models/model_table.hpp"
 #include "hilldem/motion/law_of_motion.hpp"
 
@@ -101,6 +102,12 @@ class Simulation {
   // make_dry on every hill contact; returns how many were wet.
   std::size_t make_dry();
 
+  // Existing ball-ball hill contacts go through the batched law (engine/hill_batch.hpp); false: every
+  // row through the row-by-row law (the two agree to rounding; kept for tests and comparison).
+  bool use_batched_kernel = true;
+  // Rows that went through the batched law in the last force pass.
+  std::int64_t batched_rows() const { return batched_rows_; }
+
   // Recompute every contact's mapping (after properties of bodies or contacts changed).
   void refresh_mappings();
   // Rebuild the neighbour list before the next force evaluation (after bodies were added or moved
@@ -139,8 +146,21 @@ class Simulation {
   void build_row_lists();  // per-ball row lists (CSR) and wall rows from the current rows
   void rebuild_if_needed();
   void force_pass(double dt);
-  // The force-displacement law of one row (any model and kind); false on a non-finite force.
-  bool force_row(std::size_t c, double dt);
+  // What a row gives the ball it is summed into inside the pair loop (piece 1 of a ball-ball row).
+  struct RowShare {
+    Vec3 force;   // −F_c [N] (zero when the row is not an active contact)
+    Vec3 moment;  // −(R_1 + g/2) n̂_c × F_c [N m]
+    bool ok = true;  // false on a non-finite force
+  };
+  // The force-displacement law of one row (any model and kind). Writes the row's columns and, in
+  // share_moment_, the moment on the body that collects the row after the pass (piece 2 of a ball-ball
+  // row, the ball of a ball-wall row).
+  RowShare force_row(std::size_t c, double dt);
+  // The rows of balls a0..a1-1 (ball-ball), with their half of the force sum; bad_row: the lowest
+  // row with a non-finite force.
+  void force_block(std::size_t a0, std::size_t a1, double dt, HillBatch& batch, std::vector<RowShare>& shares,
+                   std::size_t& bad_row, std::int64_t& batched);
+  // Second half of the force sum: each ball adds the rows it did not sum in the pair loop.
   void collect_forces();
   void compute_mapping(ContactStore& store, std::size_t c) const;
   // Row c becomes a contact (created by proximity) with its rule's properties.
@@ -152,6 +172,7 @@ class Simulation {
   void wrap_positions();
 
   bool forces_ready_ = false;
+  std::int64_t batched_rows_ = 0;
   bool rebuild_needed_ = true;
   std::size_t unassigned_pairs_ = 0;
   std::int64_t rebuilds_ = 0;
@@ -160,6 +181,24 @@ class Simulation {
   std::vector<std::uint32_t> ball_rows_start_;  // CSR: rows of ball i are ball_rows_[start[i]..start[i+1])
   std::vector<std::int64_t> ball_rows_;      // row r as +(r+1) when the ball is piece 2, −(r+1) piece 1
   std::vector<std::uint32_t> wall_rows_;     // rows of ball-wall pairs
+  // The force sum in two halves (each in a fixed order, so any thread count gives the same bits):
+  // the pair loop runs over balls a, through a's ball-ball rows (rows first_rows_[a]..[a+1]: keys
+  // are sorted by kind, then a), and adds each row's share to a; then each ball adds the rows of
+  // late_rows_ (CSR, row r as +(r+1) when it is piece 2 of a ball-ball row, −(r+1) for its wall
+  // rows), from F_c and share_moment_ only: one or two cache lines per entry.
+  std::vector<std::uint32_t> first_rows_;
+  std::vector<std::uint32_t> late_rows_start_;
+  std::vector<std::int32_t> late_rows_;
+  std::vector<Vec3> share_moment_;           // [N m] moment of row r on its late-collecting body
+  std::vector<Vec3> first_force_, first_moment_;  // per ball, the pair loop's half [N], [N m]
+  struct alignas(64) BallKin {
+    Vec3 position;         // [m]
+    double radius = 0.0;   // [m]
+    Vec3 velocity;         // [m/s]
+    Vec3 spin;             // [rad/s]
+    HillBodyTerms terms;   // for the hill mappings
+  };
+  std::vector<BallKin> ball_kin_;            // per ball, what the batched pair loop reads
   std::vector<double> scaled_mass_, scaled_inertia_;  // density scaling [kg], [kg m²]
 };
 

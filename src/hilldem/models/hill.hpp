@@ -49,19 +49,40 @@ struct HillMapping {
   double r_o = 0.0;         // R_o = min(R1, R2) [m] (Eq. 12)
 };
 
-inline HillMapping hill_mapping(const HillParams& p, const HillBodies& b) {
+// The per-body terms of the Table 4 mappings: each effective property is the reciprocal of a sum of
+// one such term per body, so the force pass can keep them per ball and build a contact's mapping
+// every step instead of storing it per contact (memory traffic).
+struct HillBodyTerms {
+  double inv_radius = 0.0;  // 1/R [1/m]
+  double inv_mass = 0.0;    // 1/m [1/kg]
+  double normal = 0.0;      // (1 − ν²)/E [1/Pa]
+  double shear = 0.0;       // 2 (2 − ν)(1 + ν)/E [1/Pa]
+};
+
+HILLDEM_INLINE HillBodyTerms hill_body_terms(double r, double e, double nu, double m) {
+  return {1.0 / r, 1.0 / m, (1.0 - nu * nu) / e, 2.0 * (2.0 - nu) * (1.0 + nu) / e};
+}
+
+// Table 4 mappings from the two bodies' terms; r_o = min(R1, R2) [m].
+HILLDEM_INLINE HillMapping hill_mapping(const HillParams& p, const HillBodyTerms& t1, const HillBodyTerms& t2,
+                                        double r_o) {
   HillMapping m;
-  m.eff_radius = 1.0 / (1.0 / b.r1 + 1.0 / b.r2);
-  m.eff_young = 1.0 / ((1.0 - b.nu1 * b.nu1) / b.e1 + (1.0 - b.nu2 * b.nu2) / b.e2);
-  m.eff_shear = 1.0 / (2.0 * (2.0 - b.nu1) * (1.0 + b.nu1) / b.e1 + 2.0 * (2.0 - b.nu2) * (1.0 + b.nu2) / b.e2);
-  m.eff_mass = 1.0 / (1.0 / b.m1 + 1.0 / b.m2);
+  m.eff_radius = 1.0 / (t1.inv_radius + t2.inv_radius);
+  m.eff_young = 1.0 / (t1.normal + t2.normal);
+  m.eff_shear = 1.0 / (t1.shear + t2.shear);
+  m.eff_mass = 1.0 / (t1.inv_mass + t2.inv_mass);
   const double sqrt_re = std::sqrt(m.eff_radius);
   m.kn = 4.0 / 3.0 * m.eff_young * sqrt_re;
   m.ks = 8.0 * m.eff_shear * sqrt_re;
   m.bn = p.damp_con * std::sqrt(m.eff_mass * m.kn);
   m.bs = p.damp_con * std::sqrt(m.eff_mass * m.ks);
-  m.r_o = std::min(b.r1, b.r2);
+  m.r_o = r_o;
   return m;
+}
+
+inline HillMapping hill_mapping(const HillParams& p, const HillBodies& b) {
+  return hill_mapping(p, hill_body_terms(b.r1, b.e1, b.nu1, b.m1), hill_body_terms(b.r2, b.e2, b.nu2, b.m2),
+                      std::min(b.r1, b.r2));
 }
 
 // Eq. 12 [R]: moisture force [N] (≤ 0, suction) of a wet contact at gap g [m].

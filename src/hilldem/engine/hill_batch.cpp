@@ -1,0 +1,188 @@
+#include "hilldem/engine/hill_batch.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "hilldem/models/hill.hpp"
+
+namespace hilldem {
+
+namespace {
+
+// A lane's 3-vector, read from or written to three columns.
+struct Cols {
+  double* __restrict x;
+  double* __restrict y;
+  double* __restrict z;
+  HILLDEM_INLINE Vec3 get(std::size_t i) const { return {x[i], y[i], z[i]}; }
+  HILLDEM_INLINE void set(std::size_t i, const Vec3& v) const { x[i] = v.x, y[i] = v.y, z[i] = v.z; }
+};
+
+Cols cols(HillBatch& b, HillBatch::Field first) {
+  return {b.col(first), b.col(static_cast<HillBatch::Field>(first + 1)), b.col(static_cast<HillBatch::Field>(first + 2))};
+}
+
+}  // namespace
+
+void hill_batch_forces(HillBatch& batch, double dt, bool want_stiffness) {
+  using F = HillBatch;
+  const std::size_t n = batch.size();
+  const Cols d = cols(batch, F::kDx), va = cols(batch, F::kVax), vb = cols(batch, F::kVbx);
+  const Cols wa = cols(batch, F::kWax), wb = cols(batch, F::kWbx), n_old = cols(batch, F::kNox);
+  const Cols s_old = cols(batch, F::kSx), n_new = cols(batch, F::kNx), force = cols(batch, F::kFx);
+  const Cols shear = cols(batch, F::kShx), torque = cols(batch, F::kTx);
+  const double* __restrict r1 = batch.col(F::kR1);
+  const double* __restrict r2 = batch.col(F::kR2);
+  double* __restrict kn = batch.col(F::kKn);
+  double* __restrict ks = batch.col(F::kKs);
+  double* __restrict bn = batch.col(F::kBn);
+  double* __restrict bs = batch.col(F::kBs);
+  double* __restrict ro = batch.col(F::kRo);
+  const double* __restrict fric = batch.col(F::kFric);
+  const double* __restrict suction = batch.col(F::kSuction);
+  const double* __restrict damp = batch.col(F::kDamp);
+  const double* __restrict wet = batch.col(F::kWet);
+  double* __restrict gap = batch.col(F::kGap);
+  double* __restrict fn_out = batch.col(F::kFn);
+  double* __restrict fm_out = batch.col(F::kFm);
+  double* __restrict trial_out = batch.col(F::kTrial);
+  double* __restrict active_out = batch.col(F::kActive);
+  double* __restrict ruptured = batch.col(F::kRuptured);
+  double* __restrict k_tran = batch.col(F::kKtran);
+  double* __restrict k_shear = batch.col(F::kKshear);
+
+  // 0. The mapping of each contact (hill_mapping, spec §2.4), from the per-ball terms.
+  {
+    const double* __restrict ir1 = batch.col(F::kIr1);
+    const double* __restrict ir2 = batch.col(F::kIr2);
+    const double* __restrict im1 = batch.col(F::kIm1);
+    const double* __restrict im2 = batch.col(F::kIm2);
+    const double* __restrict cn1 = batch.col(F::kCn1);
+    const double* __restrict cn2 = batch.col(F::kCn2);
+    const double* __restrict cs1 = batch.col(F::kCs1);
+    const double* __restrict cs2 = batch.col(F::kCs2);
+#pragma omp simd
+    for (std::size_t i = 0; i < n; ++i) {
+      const HillMapping m = hill_mapping(HillParams{0.0, damp[i], 0.0}, HillBodyTerms{ir1[i], im1[i], cn1[i], cs1[i]},
+                                         HillBodyTerms{ir2[i], im2[i], cn2[i], cs2[i]}, std::min(r1[i], r2[i]));
+      kn[i] = m.kn, ks[i] = m.ks, bn[i] = m.bn, bs[i] = m.bs, ro[i] = m.r_o;
+    }
+  }
+
+  // 1. Geometry (Eqs. 2-3); coincident centres keep the old normal.
+#pragma omp simd
+  for (std::size_t i = 0; i < n; ++i) {
+    const double x = d.x[i], y = d.y[i], z = d.z[i];
+    const double dist = std::sqrt(x * x + y * y + z * z);
+    const bool apart = dist > 0.0;
+    n_new.x[i] = apart ? x / dist : n_old.x[i];
+    n_new.y[i] = apart ? y / dist : n_old.y[i];
+    n_new.z[i] = apart ? z / dist : n_old.z[i];
+    gap[i] = dist - (r1[i] + r2[i]);
+  }
+
+  // 2. Moisture (Eq. 12): the bridge force or its rupture, for wet lanes only (exp does not vectorise
+  // without relaxing the math library's accuracy).
+  for (std::size_t i = 0; i < n; ++i) {
+    fm_out[i] = 0.0;
+    ruptured[i] = 0.0;
+    if (wet[i] == 0.0) continue;
+    if (gap[i] >= hill_rupture_gap(ro[i])) ruptured[i] = 1.0;
+    else fm_out[i] = hill_moisture_force(suction[i], ro[i], gap[i]);
+  }
+
+  // 3. Kinematics (§1.2), plane rotation (§1.3) and the law (Eqs. 13-18, 19-21), written out in
+  // components with every branch a select, so that the loop vectorises (GCC gives up on selects
+  // between Vec3 temporaries).
+#pragma omp simd
+  for (std::size_t i = 0; i < n; ++i) {
+    const double nx = n_new.x[i], ny = n_new.y[i], nz = n_new.z[i];
+    const double g = gap[i];
+    // Active: wet, or overlapping (spec §2.5), and not ruptured this step. As a comparison of doubles,
+    // not a bool combination, which GCC 12 will not vectorise.
+    const bool active = (wet[i] + (g <= 0.0 ? 1.0 : 0.0)) * (1.0 - ruptured[i]) > 0.0;
+    const double wax = wa.x[i], way = wa.y[i], waz = wa.z[i];
+    const double wbx = wb.x[i], wby = wb.y[i], wbz = wb.z[i];
+    // ẋ_c(1) = v1 + ω1 × (R1 + g/2) n̂,  ẋ_c(2) = v2 − ω2 × (R2 + g/2) n̂  (§1.2)
+    const double arm1 = r1[i] + 0.5 * g, arm2 = r2[i] + 0.5 * g;
+    const double ax = nx * arm1, ay = ny * arm1, az = nz * arm1;
+    const double bx = nx * arm2, by = ny * arm2, bz = nz * arm2;
+    const double v1x = va.x[i] + (way * az - waz * ay);
+    const double v1y = va.y[i] + (waz * ax - wax * az);
+    const double v1z = va.z[i] + (wax * ay - way * ax);
+    const double v2x = vb.x[i] - (wby * bz - wbz * by);
+    const double v2y = vb.y[i] - (wbz * bx - wbx * bz);
+    const double v2z = vb.z[i] - (wbx * by - wby * bx);
+    const double rx = v2x - v1x, ry = v2y - v1y, rz = v2z - v1z;
+    // Carry F^h_s into the current plane (PlaneRotation::carry): (a) tilt n_old × n̂, (b) twist
+    // n̂ ½(ω1 + ω2)·n̂ Δt, (c) drop the normal part and restore the magnitude.
+    const double ox = n_old.x[i], oy = n_old.y[i], oz = n_old.z[i];
+    const double tx = oy * nz - oz * ny, ty = oz * nx - ox * nz, tz = ox * ny - oy * nx;
+    const double spin = 0.5 * ((wax + wbx) * nx + (way + wby) * ny + (waz + wbz) * nz) * dt;
+    const double qx = nx * spin, qy = ny * spin, qz = nz * spin;
+    const double sx = s_old.x[i], sy = s_old.y[i], sz = s_old.z[i];
+    const double mag2 = sx * sx + sy * sy + sz * sz;
+    const double g1x = sx - (sy * tz - sz * ty), g1y = sy - (sz * tx - sx * tz), g1z = sz - (sx * ty - sy * tx);
+    double gx = g1x - (g1y * qz - g1z * qy), gy = g1y - (g1z * qx - g1x * qz), gz = g1z - (g1x * qy - g1y * qx);
+    const double gn = gx * nx + gy * ny + gz * nz;
+    gx = gx - nx * gn, gy = gy - ny * gn, gz = gz - nz * gn;
+    const double g2 = gx * gx + gy * gy + gz * gz;
+    const double scale = g2 > 0.0 ? std::sqrt(mag2 / g2) : 1.0;
+    const double cx = mag2 == 0.0 ? sx : gx * scale;
+    const double cy = mag2 == 0.0 ? sy : gy * scale;
+    const double cz = mag2 == 0.0 ? sz : gz * scale;
+    // Eq. 13: Hertz normal force with the δ^{1/4} dashpot.
+    const double normal_rate = rx * nx + ry * ny + rz * nz;
+    const double srx = rx - nx * normal_rate, sry = ry - ny * normal_rate, srz = rz - nz * normal_rate;
+    const double overlap = -g;
+    const bool touching = overlap > 0.0;
+    const double root2 = touching ? std::sqrt(overlap) : 0.0;
+    const double root4 = std::sqrt(root2);
+    const double fn = touching ? kn[i] * overlap * root2 + bn[i] * root4 * (-normal_rate) : 0.0;
+    // Eqs. 14-18.
+    const double strength = std::max(0.0, fric[i] * fn);
+    const double dmp = -bs[i] * root4;
+    const double dx = srx * dmp, dy = sry * dmp, dz = srz * dmp;
+    const double inc = ks[i] * root2 * dt;
+    double hx = cx - srx * inc, hy = cy - sry * inc, hz = cz - srz * inc;
+    const double ux = hx + dx, uy = hy + dy, uz = hz + dz;
+    const double trial = std::sqrt(ux * ux + uy * uy + uz * uz);
+    const double hm_mag = std::sqrt(hx * hx + hy * hy + hz * hz);
+    const double clamp = hm_mag > strength ? (hm_mag > 0.0 ? strength / hm_mag : 0.0) : 1.0;
+    hx = hm_mag > strength ? hx * clamp : hx;
+    hy = hm_mag > strength ? hy * clamp : hy;
+    hz = hm_mag > strength ? hz * clamp : hz;
+    const double ex = hx + dx, ey = hy + dy, ez = hz + dz;
+    const double t_mag = std::sqrt(ex * ex + ey * ey + ez * ez);
+    const double slip = t_mag <= strength ? 1.0 : strength / t_mag;
+    const double fsx = touching ? (t_mag <= strength ? ex : ex * slip) : 0.0;
+    const double fsy = touching ? (t_mag <= strength ? ey : ey * slip) : 0.0;
+    const double fsz = touching ? (t_mag <= strength ? ez : ez * slip) : 0.0;
+    const double fm = fm_out[i];
+    const double fnm = fn + fm;
+    // An inactive contact gives no force and forgets its shear force (Eq. 16 with F^μ_s = 0).
+    const double fx = active ? nx * fnm + fsx : 0.0;
+    const double fy = active ? ny * fnm + fsy : 0.0;
+    const double fz = active ? nz * fnm + fsz : 0.0;
+    force.x[i] = fx, force.y[i] = fy, force.z[i] = fz;
+    shear.x[i] = active ? hx : 0.0, shear.y[i] = active ? hy : 0.0, shear.z[i] = active ? hz : 0.0;
+    torque.x[i] = ny * fz - nz * fy, torque.y[i] = nz * fx - nx * fz, torque.z[i] = nx * fy - ny * fx;
+    fn_out[i] = active ? fn : 0.0;
+    fm_out[i] = active ? fm : 0.0;
+    trial_out[i] = active ? trial : 0.0;
+    active_out[i] = active ? 1.0 : 0.0;
+    if (want_stiffness) {  // Eqs. 19-21 (hill_timestep_stiffness)
+      const double ov = overlap <= 0.0 ? kHillTimestepOverlapFactor * ro[i] : overlap;
+      const double sr = std::sqrt(ov);
+      const double xi = damp[i] / 2.0;
+      const double f = std::sqrt(1.0 + xi * xi) - xi;
+      const double f2 = damp[i] > 0.0 ? f * f : 1.0;
+      const double skn = damp[i] > 0.0 ? 1.5 * kn[i] * sr / f2 : 1.5 * kn[i] * sr;
+      const double sks = damp[i] > 0.0 ? ks[i] * sr / f2 : ks[i] * sr;
+      k_tran[i] = active ? skn + sks : 0.0;
+      k_shear[i] = active ? sks : 0.0;
+    }
+  }
+}
+
+}  // namespace hilldem
