@@ -242,20 +242,17 @@ void Simulation::rebuild(double proximity) {
 }
 
 void Simulation::build_row_lists() {
-  // Per-ball row lists (CSR), in row order: the fixed summation order of ball_stiffness().
+  // The row lists of the two halves of every per-ball sum (see first_rows_ / late_rows_), in row order.
   const std::size_t n = balls.size();
   const std::size_t rows = contacts.size();
   if (rows > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
     throw RunError("too many neighbour pairs (" + std::to_string(rows) + ") for one process");
-  ball_rows_start_.assign(n + 1, 0);
   first_rows_.assign(n + 1, 0);
   late_rows_start_.assign(n + 1, 0);
   wall_rows_.clear();
   for (std::size_t c = 0; c < rows; ++c) {
     const ContactKey& k = contacts.key[c];
-    ++ball_rows_start_[k.a + 1];
     if (k.kind == ContactKind::BallBall) {
-      ++ball_rows_start_[k.b + 1];
       ++first_rows_[k.a + 1];
       ++late_rows_start_[k.b + 1];
     } else {
@@ -264,28 +261,23 @@ void Simulation::build_row_lists() {
     }
   }
   for (std::size_t i = 0; i < n; ++i) {
-    ball_rows_start_[i + 1] += ball_rows_start_[i];
     first_rows_[i + 1] += first_rows_[i];
     late_rows_start_[i + 1] += late_rows_start_[i];
   }
-  ball_rows_.assign(ball_rows_start_[n], 0);
   late_rows_.assign(late_rows_start_[n], 0);
-  std::vector<std::uint32_t> fill(ball_rows_start_.begin(), ball_rows_start_.end() - 1);
   std::vector<std::uint32_t> late_fill(late_rows_start_.begin(), late_rows_start_.end() - 1);
   for (std::size_t c = 0; c < rows; ++c) {
     const ContactKey& k = contacts.key[c];
-    const auto row = static_cast<std::int64_t>(c) + 1;
-    ball_rows_[fill[k.a]++] = -row;
-    if (k.kind == ContactKind::BallBall) {
-      ball_rows_[fill[k.b]++] = row;
-      late_rows_[late_fill[k.b]++] = static_cast<std::int32_t>(row);
-    } else {
-      late_rows_[late_fill[k.a]++] = static_cast<std::int32_t>(-row);
-    }
+    const auto row = static_cast<std::int32_t>(c) + 1;
+    if (k.kind == ContactKind::BallBall) late_rows_[late_fill[k.b]++] = row;
+    else late_rows_[late_fill[k.a]++] = -row;
   }
   share_moment_.assign(rows, Vec3{});
   first_force_.assign(n, Vec3{});
   first_moment_.assign(n, Vec3{});
+  ball_k_tran_.assign(n, 0.0);
+  ball_k_rot_.assign(n, 0.0);
+  stiffness_ready_ = false;
 }
 
 CycleState Simulation::cycle_state() const {
@@ -527,7 +519,8 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, double dt, HillBatc
     }
   }
   if (batch.size() > 0) flush();
-  // Ball a's half of the force sum, its rows in row order.
+  // Ball a's half of the force sum, its rows in row order; and of its stiffness sums when the time
+  // step or density scaling needs them.
   for (std::size_t a = a0; a < a1; ++a) {
     Vec3 f, m;
     for (std::size_t c = first_rows_[a]; c < first_rows_[a + 1]; ++c) {
@@ -536,6 +529,12 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, double dt, HillBatc
     }
     first_force_[a] = f;
     first_moment_[a] = m;
+    if (want_stiffness) {
+      double k_tran = 0.0, k_rot = 0.0;
+      for (std::size_t c = first_rows_[a]; c < first_rows_[a + 1]; ++c) add_row_stiffness(c, kin[a].radius, k_tran, k_rot);
+      ball_k_tran_[a] = k_tran;
+      ball_k_rot_[a] = k_rot;
+    }
   }
 }
 
@@ -590,6 +589,7 @@ void Simulation::collect_forces() {
   const std::size_t n = balls.size();
   const Vec3* force = contacts.force.data();
   const Vec3* moment = share_moment_.data();
+  const bool want_stiffness = settings.auto_timestep || settings.density_scaling;
 #pragma omp parallel for schedule(static) if (n > kParallelMin)
   for (std::size_t i = 0; i < n; ++i) {
     Vec3 f = first_force_[i], m = first_moment_[i];
@@ -602,7 +602,15 @@ void Simulation::collect_forces() {
     }
     balls.contact_force[i] = f;
     balls.contact_moment[i] = m;
+    if (want_stiffness) {  // the second half of the stiffness sums (the order of ball_stiffness())
+      double k_tran = ball_k_tran_[i], k_rot = ball_k_rot_[i];
+      for (std::uint32_t k = late_rows_start_[i]; k < late_rows_start_[i + 1]; ++k)
+        add_row_stiffness(static_cast<std::size_t>(std::abs(late_rows_[k]) - 1), balls.radius[i], k_tran, k_rot);
+      ball_k_tran_[i] = k_tran;
+      ball_k_rot_[i] = k_rot;
+    }
   }
+  stiffness_ready_ = want_stiffness;
   for (Wall& w : walls.walls) {
     w.force = w.moment = Vec3{};
     w.normal_force = w.normal_stiffness = 0.0;
@@ -621,16 +629,26 @@ void Simulation::collect_forces() {
   }
 }
 
+void Simulation::add_row_stiffness(std::size_t c, double radius, double& k_tran, double& k_rot) const {
+  if (!contacts.active[c]) return;
+  const double arm = radius + 0.5 * contacts.gap[c];  // |x_c − x| (the contact point is on the normal)
+  k_tran += contacts.k_tran[c];
+  k_rot += contacts.k_shear[c] * arm * arm;
+}
+
 void Simulation::ball_stiffness(std::size_t i, double& k_tran, double& k_rot) const {
-  k_tran = k_rot = 0.0;
-  if (i + 1 >= ball_rows_start_.size()) return;  // a ball added since the last rebuild: no contacts yet
-  for (std::uint32_t k = ball_rows_start_[i]; k < ball_rows_start_[i + 1]; ++k) {
-    const std::size_t c = static_cast<std::size_t>(std::abs(ball_rows_[k]) - 1);
-    if (!contacts.active[c]) continue;
-    const double arm = balls.radius[i] + 0.5 * contacts.gap[c];  // |x_c − x| (the contact point is on the normal)
-    k_tran += contacts.k_tran[c];
-    k_rot += contacts.k_shear[c] * arm * arm;
+  if (stiffness_ready_) {  // summed by the last force pass
+    k_tran = ball_k_tran_[i];
+    k_rot = ball_k_rot_[i];
+    return;
   }
+  // The same sums from the rows, in the same order (rows as first ball, then the late rows), so the
+  // result does not depend on which way it was computed (a resumed run takes this way first).
+  k_tran = k_rot = 0.0;
+  if (i + 1 >= first_rows_.size()) return;  // a ball added since the last rebuild: no contacts yet
+  for (std::size_t c = first_rows_[i]; c < first_rows_[i + 1]; ++c) add_row_stiffness(c, balls.radius[i], k_tran, k_rot);
+  for (std::uint32_t k = late_rows_start_[i]; k < late_rows_start_[i + 1]; ++k)
+    add_row_stiffness(static_cast<std::size_t>(std::abs(late_rows_[k]) - 1), balls.radius[i], k_tran, k_rot);
 }
 
 double Simulation::estimate_timestep() const {

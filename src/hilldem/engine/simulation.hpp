@@ -167,6 +167,8 @@ class Simulation {
   void create_contact(std::size_t c, const Vec3& normal);
   // Σ over ball i's active contacts: k_tran = Σ(k̂_n + k̂_s) [N/m], k_rot = Σ k̂_s |x_c − x|² [N m].
   void ball_stiffness(std::size_t i, double& k_tran, double& k_rot) const;
+  // Row c's terms of those sums for a ball of the given radius [m] (if the row is an active contact).
+  void add_row_stiffness(std::size_t c, double radius, double& k_tran, double& k_rot) const;
   std::uint64_t piece2_groups(const ContactKey& k) const;
   double skin() const;
   void wrap_positions();
@@ -178,8 +180,6 @@ class Simulation {
   std::int64_t rebuilds_ = 0;
   std::vector<Vec3> position_at_build_;
   double wall_travel_ = 0.0;                 // bound on any wall point's motion since the rebuild [m]
-  std::vector<std::uint32_t> ball_rows_start_;  // CSR: rows of ball i are ball_rows_[start[i]..start[i+1])
-  std::vector<std::int64_t> ball_rows_;      // row r as +(r+1) when the ball is piece 2, −(r+1) piece 1
   std::vector<std::uint32_t> wall_rows_;     // rows of ball-wall pairs
   // The force sum in two halves (each in a fixed order, so any thread count gives the same bits):
   // the pair loop runs over balls a, through a's ball-ball rows (rows first_rows_[a]..[a+1]: keys
@@ -191,6 +191,10 @@ class Simulation {
   std::vector<std::int32_t> late_rows_;
   std::vector<Vec3> share_moment_;           // [N m] moment of row r on its late-collecting body
   std::vector<Vec3> first_force_, first_moment_;  // per ball, the pair loop's half [N], [N m]
+  // Per ball, Σ(k̂_n + k̂_s) [N/m] and Σ k̂_s |x_c − x|² [N m] of the last force pass (in the same two
+  // halves as the forces), valid while stiffness_ready_.
+  std::vector<double> ball_k_tran_, ball_k_rot_;
+  bool stiffness_ready_ = false;
   struct alignas(64) BallKin {
     Vec3 position;         // [m]
     double radius = 0.0;   // [m]
