@@ -9,7 +9,7 @@
 
 #include "hilldem/contact/cell_grid.hpp"
 #include "hilldem/core/error.hpp"
-#include "hilldem/engine/hill_batch.hpp"
+#include "hilldem/engine/contact_batch.hpp"
 
 namespace hilldem {
 
@@ -410,10 +410,10 @@ Simulation::RowShare Simulation::force_row(std::size_t c, double dt) {
   return share;
 }
 
-void Simulation::force_block(std::size_t a0, std::size_t a1, double dt, HillBatch& batch,
-                             std::vector<RowShare>& shares, std::size_t& bad_row, std::int64_t& batched_count) {
-  // Rows of balls a0..a1-1 (ball-ball rows, contiguous). Existing hill contacts go through the batch;
-  // new contacts, other models and the shear-displacement tracking through force_row().
+void Simulation::force_block(std::size_t a0, std::size_t a1, double dt, BlockScratch& scratch, std::size_t& bad_row,
+                             std::int64_t& batched_count) {
+  // Rows of balls a0..a1-1 (ball-ball rows, contiguous). Existing hill and linear contacts go through
+  // the batches; new contacts and the shear-displacement tracking through force_row().
   const std::size_t r0 = first_rows_[a0], r1 = first_rows_[a1];
   const double proximity = settings.proximity;
   const bool want_stiffness = settings.auto_timestep || settings.density_scaling;
@@ -422,25 +422,30 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, double dt, HillBatc
   const BallKin* kin = ball_kin_.data();
   const ContactKey* keys = contacts.key.data();
   constexpr std::size_t kPrefetchRows = 16;
+  std::vector<RowShare>& shares = scratch.shares;
   shares.assign(r1 - r0, RowShare{});
-  batch.clear();
-  using F = HillBatch;
-  auto put3 = [&batch](F::Field f, std::size_t lane, const Vec3& v) {
+  using F = ContactBatch;
+  ContactBatch& hill = scratch.hill;
+  ContactBatch& linear = scratch.linear;
+  hill.clear();
+  linear.clear();
+  auto put3 = [](ContactBatch& batch, F::Field f, std::size_t lane, const Vec3& v) {
     batch.col(f)[lane] = v.x;
     batch.col(static_cast<F::Field>(f + 1))[lane] = v.y;
     batch.col(static_cast<F::Field>(f + 2))[lane] = v.z;
   };
-  auto get3 = [&batch](F::Field f, std::size_t lane) {
+  auto get3 = [](ContactBatch& batch, F::Field f, std::size_t lane) {
     return Vec3{batch.col(f)[lane], batch.col(static_cast<F::Field>(f + 1))[lane],
                 batch.col(static_cast<F::Field>(f + 2))[lane]};
   };
   // The law of the gathered lanes, and their results into the rows.
-  auto flush = [&]() {
-    hill_batch_forces(batch, dt, want_stiffness);
+  auto flush = [&](ContactBatch& batch) {
+    if (&batch == &hill) hill_batch_forces(batch, dt, want_stiffness);
+    else linear_batch_forces(batch, dt, want_stiffness);
     batched_count += static_cast<std::int64_t>(batch.size());
     for (std::size_t lane = 0; lane < batch.size(); ++lane) {
       const std::size_t c = batch.row(lane);
-      const Vec3 normal = get3(F::kNx, lane);
+      const Vec3 normal = get3(batch, F::kNx, lane);
       const double g = batch.col(F::kGap)[lane];
       const bool active = batch.col(F::kActive)[lane] != 0.0;
       if (!active && g > proximity) {  // deleted when inactive beyond proximity (§2.5)
@@ -450,13 +455,13 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, double dt, HillBatc
         share_moment_[c] = Vec3{};
         continue;
       }
-      const Vec3 force = get3(F::kFx, lane), torque = get3(F::kTx, lane);
+      const Vec3 force = get3(batch, F::kFx, lane), torque = get3(batch, F::kTx, lane);
       const double half_gap = 0.5 * g;
       RowShare& share = shares[c - r0];
       share = RowShare{-force, torque * -(batch.col(F::kR1)[lane] + half_gap), std::isfinite(force.x + force.y + force.z)};
       if (!share.ok) bad_row = std::min(bad_row, c);
       share_moment_[c] = torque * -(batch.col(F::kR2)[lane] + half_gap);
-      contacts.shear_state[c] = get3(F::kShx, lane);
+      contacts.shear_state[c] = get3(batch, F::kShx, lane);
       contacts.normal[c] = normal;
       contacts.gap[c] = g;
       contacts.force[c] = force;
@@ -492,33 +497,42 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, double dt, HillBatc
         const double reach = ka.radius + kb.radius + proximity;
         if (norm2(d) > reach * reach) continue;
       }
-      if (!batched || !exists || contacts.model[c] != ModelKind::Hill) {
+      if (!batched || !exists) {
         shares[c - r0] = force_row(c, dt);
         if (!shares[c - r0].ok) bad_row = std::min(bad_row, c);
         continue;
       }
-      if (batch.full()) flush();
+      const bool is_hill = contacts.model[c] == ModelKind::Hill;
+      ContactBatch& batch = is_hill ? hill : linear;
+      if (batch.full()) flush(batch);
       const std::size_t lane = batch.add(static_cast<std::uint32_t>(c));
-      put3(F::kDx, lane, d);
+      put3(batch, F::kDx, lane, d);
       batch.col(F::kR1)[lane] = ka.radius;
       batch.col(F::kR2)[lane] = kb.radius;
-      put3(F::kVax, lane, ka.velocity);
-      put3(F::kVbx, lane, kb.velocity);
-      put3(F::kWax, lane, ka.spin);
-      put3(F::kWbx, lane, kb.spin);
-      put3(F::kNox, lane, contacts.normal[c]);
-      put3(F::kSx, lane, contacts.shear_state[c]);
-      batch.col(F::kIr1)[lane] = ka.terms.inv_radius, batch.col(F::kIm1)[lane] = ka.terms.inv_mass;
-      batch.col(F::kCn1)[lane] = ka.terms.normal, batch.col(F::kCs1)[lane] = ka.terms.shear;
-      batch.col(F::kIr2)[lane] = kb.terms.inv_radius, batch.col(F::kIm2)[lane] = kb.terms.inv_mass;
-      batch.col(F::kCn2)[lane] = kb.terms.normal, batch.col(F::kCs2)[lane] = kb.terms.shear;
-      const HillParams& p = contacts.hill_params[c];
-      batch.col(F::kFric)[lane] = p.fric_coef, batch.col(F::kSuction)[lane] = p.suction;
-      batch.col(F::kDamp)[lane] = p.damp_con;
-      batch.col(F::kWet)[lane] = contacts.moisture[c] == Moisture::Wet ? 1.0 : 0.0;
+      put3(batch, F::kVax, lane, ka.velocity);
+      put3(batch, F::kVbx, lane, kb.velocity);
+      put3(batch, F::kWax, lane, ka.spin);
+      put3(batch, F::kWbx, lane, kb.spin);
+      put3(batch, F::kNox, lane, contacts.normal[c]);
+      put3(batch, F::kSx, lane, contacts.shear_state[c]);
+      if (is_hill) {
+        batch.col(F::kIr1)[lane] = ka.terms.inv_radius, batch.col(F::kIm1)[lane] = ka.terms.inv_mass;
+        batch.col(F::kCn1)[lane] = ka.terms.normal, batch.col(F::kCs1)[lane] = ka.terms.shear;
+        batch.col(F::kIr2)[lane] = kb.terms.inv_radius, batch.col(F::kIm2)[lane] = kb.terms.inv_mass;
+        batch.col(F::kCn2)[lane] = kb.terms.normal, batch.col(F::kCs2)[lane] = kb.terms.shear;
+        const HillParams& p = contacts.hill_params[c];
+        batch.col(F::kFric)[lane] = p.fric_coef, batch.col(F::kSuction)[lane] = p.suction;
+        batch.col(F::kDamp)[lane] = p.damp_con;
+        batch.col(F::kWet)[lane] = contacts.moisture[c] == Moisture::Wet ? 1.0 : 0.0;
+      } else {
+        batch.col(F::kIr1)[lane] = contacts.linear_map[c].kn;
+        batch.col(F::kIr2)[lane] = contacts.linear_map[c].ks;
+        batch.col(F::kFric)[lane] = contacts.linear_params[c].fric;
+      }
     }
   }
-  if (batch.size() > 0) flush();
+  if (hill.size() > 0) flush(hill);
+  if (linear.size() > 0) flush(linear);
   // Ball a's half of the force sum, its rows in row order; and of its stiffness sums when the time
   // step or density scaling needs them.
   for (std::size_t a = a0; a < a1; ++a) {
@@ -558,11 +572,10 @@ void Simulation::force_pass(double dt) {
     for (std::size_t i = 0; i < n; ++i)
       ball_kin_[i] = {balls.position[i], balls.radius[i], balls.velocity[i], balls.spin[i],
                     hill_body_terms(balls.radius[i], balls.young_mod[i], balls.pois_ratio[i], balls.mass[i])};
-    auto batch = std::make_unique<HillBatch>();  // ≈ 30 kB: on the heap, not the thread's stack
-    std::vector<RowShare> shares;
+    auto scratch = std::make_unique<BlockScratch>();  // ≈ 60 kB: on the heap, not the thread's stack
 #pragma omp for schedule(static)
     for (std::size_t k = 0; k < blocks; ++k)
-      force_block(k * kBlock, std::min(n, (k + 1) * kBlock), dt, *batch, shares, bad_row, batched);
+      force_block(k * kBlock, std::min(n, (k + 1) * kBlock), dt, *scratch, bad_row, batched);
   }
   batched_rows_ = batched;
   const std::size_t wall_rows = wall_rows_.size();

@@ -17,7 +17,7 @@
 #include "hilldem/bodies/ball_store.hpp"
 #include "hilldem/bodies/wall_store.hpp"
 #include "hilldem/contact/contact_store.hpp"
-#include "hilldem/engine/hill_batch.hpp"
+#include "hilldem/engine/contact_batch.hpp"
 #include "hilldem/models/model_table.hpp"
 #include "hilldem/motion/law_of_motion.hpp"
 
@@ -102,8 +102,8 @@ class Simulation {
   // make_dry on every hill contact; returns how many were wet.
   std::size_t make_dry();
 
-  // Existing ball-ball hill contacts go through the batched law (engine/hill_batch.hpp); false: every
-  // row through the row-by-row law (the two agree to rounding; kept for tests and comparison).
+  // Existing ball-ball contacts go through the batched laws (engine/contact_batch.hpp); false: every
+  // row through the row-by-row laws (the two agree to rounding; kept for tests and comparison).
   bool use_batched_kernel = true;
   // Rows that went through the batched law in the last force pass.
   std::int64_t batched_rows() const { return batched_rows_; }
@@ -158,8 +158,15 @@ class Simulation {
   RowShare force_row(std::size_t c, double dt);
   // The rows of balls a0..a1-1 (ball-ball), with their half of the force sum; bad_row: the lowest
   // row with a non-finite force.
-  void force_block(std::size_t a0, std::size_t a1, double dt, HillBatch& batch, std::vector<RowShare>& shares,
-                   std::size_t& bad_row, std::int64_t& batched);
+  // What one thread reuses from block to block.
+  struct BlockScratch {
+    ContactBatch hill, linear;
+    std::vector<RowShare> shares;
+  };
+  // The rows of balls a0..a1-1 (ball-ball), with their half of the force sum; bad_row: the lowest
+  // row with a non-finite force; batched: + the rows that went through a batch.
+  void force_block(std::size_t a0, std::size_t a1, double dt, BlockScratch& scratch, std::size_t& bad_row,
+                   std::int64_t& batched);
   // Second half of the force sum: each ball adds the rows it did not sum in the pair loop.
   void collect_forces();
   void compute_mapping(ContactStore& store, std::size_t c) const;

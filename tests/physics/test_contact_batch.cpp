@@ -1,5 +1,5 @@
-// The batched hill law (engine/hill_batch.hpp) against the row-by-row law (force_row): the same
-// contacts, forces and motion to rounding, dry and wet, with creation, deletion and rupture.
+// The batched hill and linear laws (engine/contact_batch.hpp) against the row-by-row laws (force_row):
+// the same contacts, forces and motion to rounding, dry and wet, with creation, deletion and rupture.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -76,6 +76,30 @@ TEST(HillBatch, RuptureAtTheSameStep) {
   ASSERT_GT(batch.first, 0);
   EXPECT_EQ(batch.first, rows.first);
   EXPECT_LT(worst_position_gap(batch.second, rows.second), 1e-15);
+}
+
+// The linear law between grains, as in the packing phase of material genesis (E* 100 MPa, κ* 1.5,
+// μ 0.3), the grains thrown down onto the floor by a strong gravity (2000 m/s²) with local damping:
+// the same motion either way.
+TEST(LinearBatch, SameMotionAsTheRowByRowLaw) {
+  auto run = [](bool batched) {
+    Simulation sim = random_box(600, 5);
+    ModelRule& grains = sim.table.rules.at(0);
+    grains.model = ModelKind::Linear;
+    grains.linear = {100e6, 1.5, 0.3};
+    sim.use_batched_kernel = batched;
+    sim.settings.gravity = {0, 0, -2000.0};
+    sim.settings.local_damping = 0.7;
+    sim.settings.timestep = 2e-6;  // [s] half the critical step of the walls
+    sim.cycle(4000);
+    return outcome(sim);
+  };
+  const Outcome batch = run(true), rows = run(false);
+  EXPECT_GT(batch.batched, 150);
+  EXPECT_EQ(rows.batched, 0);
+  EXPECT_GT(batch.contacts, 200u);
+  EXPECT_EQ(batch.contacts, rows.contacts);
+  EXPECT_LT(worst_position_gap(batch, rows), 1e-12) << worst_position_gap(batch, rows);
 }
 
 }  // namespace

@@ -1,13 +1,15 @@
-// HillBatch: the hill law of many ball-ball contacts at once, in structure-of-arrays lanes.
+// ContactBatch: the hill law of many ball-ball contacts at once, in structure-of-arrays lanes.
 //
 // Why: one contact's law is a long chain of dependent square roots and divisions (distance, normal,
 // the carried shear's magnitude, δ^{1/2}, δ^{1/4}, two norms and two clamps): ≈ 150 cycles of latency,
 // longer than the out-of-order window of a core, so a row-by-row loop runs at the speed of that chain.
-// Here the force pass gathers the existing ball-ball hill contacts of a block of balls into lanes,
+// (The linear law's chain is shorter, but the same lanes pay there too.)
+// Here the force pass gathers the existing ball-ball contacts of a block of balls into lanes (one
+// batch per model),
 // runs the law as a few simple loops over the lanes (vectorised by the compiler, every branch a
 // select), and scatters the results back. The arithmetic is that of force_row() (spec §1.1–1.3 and
 // hill Eqs. 12–21) in the same order; only the compiler's fusing of multiply-adds may differ, so
-// results agree with the row-by-row path to rounding (test HillBatch.*).
+// results agree with the row-by-row path to rounding (test ContactBatch.*).
 #pragma once
 
 #include <cstddef>
@@ -15,7 +17,7 @@
 
 namespace hilldem {
 
-class HillBatch {
+class ContactBatch {
  public:
   // Lane columns. Inputs are gathered by the force pass; outputs are written by hill_batch_forces().
   enum Field : int {
@@ -28,6 +30,7 @@ class HillBatch {
     kWbx, kWby, kWbz,   // spin of ball 2 [rad/s]
     kNox, kNoy, kNoz,   // n̂_c of the last step
     kSx, kSy, kSz,      // F^h_s of the last step [N], in its plane
+    // hill: the per-ball terms of the mapping; linear: kIr1 = k_n, kIr2 = k_s [N/m] (LinearMapping)
     kIr1, kIr2, kIm1, kIm2,   // 1/R [1/m], 1/m [1/kg] of balls 1 and 2 (HillBodyTerms)
     kCn1, kCn2, kCs1, kCs2,   // (1 − ν²)/E, 2(2 − ν)(1 + ν)/E [1/Pa] of balls 1 and 2
     kFric, kSuction, kDamp,   // μ [-], ψ [Pa], γ_h [-]
@@ -72,6 +75,10 @@ class HillBatch {
 // The hill law of every lane over a step of dt [s]: geometry (Eqs. 2-3), relative velocity at the
 // contact point (§1.2), the plane's rotation carried into F^h_s (§1.3), then Eqs. 12-18 and, when
 // want_stiffness is set, Eqs. 19-21.
-void hill_batch_forces(HillBatch& batch, double dt, bool want_stiffness);
+void hill_batch_forces(ContactBatch& batch, double dt, bool want_stiffness);
+
+// The linear law (spec §3) of every lane: k_n, k_s in kIr1, kIr2, μ in kFric; the same outputs (F^m,
+// rupture 0; the stiffnesses k_n, k_s when want_stiffness).
+void linear_batch_forces(ContactBatch& batch, double dt, bool want_stiffness);
 
 }  // namespace hilldem

@@ -1,9 +1,10 @@
-#include "hilldem/engine/hill_batch.hpp"
+#include "hilldem/engine/contact_batch.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 #include "hilldem/models/hill.hpp"
+#include "hilldem/models/linear.hpp"
 
 namespace hilldem {
 
@@ -18,16 +19,36 @@ struct Cols {
   HILLDEM_INLINE void set(std::size_t i, const Vec3& v) const { x[i] = v.x, y[i] = v.y, z[i] = v.z; }
 };
 
-Cols cols(HillBatch& b, HillBatch::Field first) {
-  return {b.col(first), b.col(static_cast<HillBatch::Field>(first + 1)), b.col(static_cast<HillBatch::Field>(first + 2))};
+Cols cols(ContactBatch& b, ContactBatch::Field first) {
+  return {b.col(first), b.col(static_cast<ContactBatch::Field>(first + 1)), b.col(static_cast<ContactBatch::Field>(first + 2))};
+}
+
+// Geometry (Eqs. 2-3) of every lane; coincident centres keep the old normal.
+void batch_geometry(ContactBatch& batch) {
+  using F = ContactBatch;
+  const std::size_t n = batch.size();
+  const Cols d = cols(batch, F::kDx), n_old = cols(batch, F::kNox), n_new = cols(batch, F::kNx);
+  const double* __restrict r1 = batch.col(F::kR1);
+  const double* __restrict r2 = batch.col(F::kR2);
+  double* __restrict gap = batch.col(F::kGap);
+#pragma omp simd
+  for (std::size_t i = 0; i < n; ++i) {
+    const double x = d.x[i], y = d.y[i], z = d.z[i];
+    const double dist = std::sqrt(x * x + y * y + z * z);
+    const bool apart = dist > 0.0;
+    n_new.x[i] = apart ? x / dist : n_old.x[i];
+    n_new.y[i] = apart ? y / dist : n_old.y[i];
+    n_new.z[i] = apart ? z / dist : n_old.z[i];
+    gap[i] = dist - (r1[i] + r2[i]);
+  }
 }
 
 }  // namespace
 
-void hill_batch_forces(HillBatch& batch, double dt, bool want_stiffness) {
-  using F = HillBatch;
+void hill_batch_forces(ContactBatch& batch, double dt, bool want_stiffness) {
+  using F = ContactBatch;
   const std::size_t n = batch.size();
-  const Cols d = cols(batch, F::kDx), va = cols(batch, F::kVax), vb = cols(batch, F::kVbx);
+  const Cols va = cols(batch, F::kVax), vb = cols(batch, F::kVbx);
   const Cols wa = cols(batch, F::kWax), wb = cols(batch, F::kWbx), n_old = cols(batch, F::kNox);
   const Cols s_old = cols(batch, F::kSx), n_new = cols(batch, F::kNx), force = cols(batch, F::kFx);
   const Cols shear = cols(batch, F::kShx), torque = cols(batch, F::kTx);
@@ -69,17 +90,7 @@ void hill_batch_forces(HillBatch& batch, double dt, bool want_stiffness) {
     }
   }
 
-  // 1. Geometry (Eqs. 2-3); coincident centres keep the old normal.
-#pragma omp simd
-  for (std::size_t i = 0; i < n; ++i) {
-    const double x = d.x[i], y = d.y[i], z = d.z[i];
-    const double dist = std::sqrt(x * x + y * y + z * z);
-    const bool apart = dist > 0.0;
-    n_new.x[i] = apart ? x / dist : n_old.x[i];
-    n_new.y[i] = apart ? y / dist : n_old.y[i];
-    n_new.z[i] = apart ? z / dist : n_old.z[i];
-    gap[i] = dist - (r1[i] + r2[i]);
-  }
+  batch_geometry(batch);
 
   // 2. Moisture (Eq. 12): the bridge force or its rupture, for wet lanes only (exp does not vectorise
   // without relaxing the math library's accuracy).
@@ -181,6 +192,90 @@ void hill_batch_forces(HillBatch& batch, double dt, bool want_stiffness) {
       const double sks = damp[i] > 0.0 ? ks[i] * sr / f2 : ks[i] * sr;
       k_tran[i] = active ? skn + sks : 0.0;
       k_shear[i] = active ? sks : 0.0;
+    }
+  }
+}
+
+void linear_batch_forces(ContactBatch& batch, double dt, bool want_stiffness) {
+  using F = ContactBatch;
+  const std::size_t n = batch.size();
+  batch_geometry(batch);
+  const Cols va = cols(batch, F::kVax), vb = cols(batch, F::kVbx), wa = cols(batch, F::kWax);
+  const Cols wb = cols(batch, F::kWbx), n_old = cols(batch, F::kNox), s_old = cols(batch, F::kSx);
+  const Cols n_new = cols(batch, F::kNx), force = cols(batch, F::kFx), shear = cols(batch, F::kShx);
+  const Cols torque = cols(batch, F::kTx);
+  const double* __restrict r1 = batch.col(F::kR1);
+  const double* __restrict r2 = batch.col(F::kR2);
+  const double* __restrict kn = batch.col(F::kIr1);
+  const double* __restrict ks = batch.col(F::kIr2);
+  const double* __restrict fric = batch.col(F::kFric);
+  const double* __restrict gap = batch.col(F::kGap);
+  double* __restrict fn_out = batch.col(F::kFn);
+  double* __restrict fm_out = batch.col(F::kFm);
+  double* __restrict trial_out = batch.col(F::kTrial);
+  double* __restrict active_out = batch.col(F::kActive);
+  double* __restrict ruptured = batch.col(F::kRuptured);
+  double* __restrict k_tran = batch.col(F::kKtran);
+  double* __restrict k_shear = batch.col(F::kKshear);
+  // Kinematics (§1.2), plane rotation (§1.3) and the linear law (§3), in components (see above).
+#pragma omp simd
+  for (std::size_t i = 0; i < n; ++i) {
+    const double nx = n_new.x[i], ny = n_new.y[i], nz = n_new.z[i];
+    const double g = gap[i];
+    const bool active = g < 0.0;  // overlapping; no tension, no reference gap
+    const double wax = wa.x[i], way = wa.y[i], waz = wa.z[i];
+    const double wbx = wb.x[i], wby = wb.y[i], wbz = wb.z[i];
+    const double arm1 = r1[i] + 0.5 * g, arm2 = r2[i] + 0.5 * g;
+    const double ax = nx * arm1, ay = ny * arm1, az = nz * arm1;
+    const double bx = nx * arm2, by = ny * arm2, bz = nz * arm2;
+    const double v1x = va.x[i] + (way * az - waz * ay);
+    const double v1y = va.y[i] + (waz * ax - wax * az);
+    const double v1z = va.z[i] + (wax * ay - way * ax);
+    const double v2x = vb.x[i] - (wby * bz - wbz * by);
+    const double v2y = vb.y[i] - (wbz * bx - wbx * bz);
+    const double v2z = vb.z[i] - (wbx * by - wby * bx);
+    const double rx = v2x - v1x, ry = v2y - v1y, rz = v2z - v1z;
+    const double ox = n_old.x[i], oy = n_old.y[i], oz = n_old.z[i];
+    const double tx = oy * nz - oz * ny, ty = oz * nx - ox * nz, tz = ox * ny - oy * nx;
+    const double spin = 0.5 * ((wax + wbx) * nx + (way + wby) * ny + (waz + wbz) * nz) * dt;
+    const double qx = nx * spin, qy = ny * spin, qz = nz * spin;
+    const double sx = s_old.x[i], sy = s_old.y[i], sz = s_old.z[i];
+    const double mag2 = sx * sx + sy * sy + sz * sz;
+    const double g1x = sx - (sy * tz - sz * ty), g1y = sy - (sz * tx - sx * tz), g1z = sz - (sx * ty - sy * tx);
+    double gx = g1x - (g1y * qz - g1z * qy), gy = g1y - (g1z * qx - g1x * qz), gz = g1z - (g1x * qy - g1y * qx);
+    const double gn = gx * nx + gy * ny + gz * nz;
+    gx = gx - nx * gn, gy = gy - ny * gn, gz = gz - nz * gn;
+    const double g2 = gx * gx + gy * gy + gz * gz;
+    const double scale = g2 > 0.0 ? std::sqrt(mag2 / g2) : 1.0;
+    const double cx = mag2 == 0.0 ? sx : gx * scale;
+    const double cy = mag2 == 0.0 ? sy : gy * scale;
+    const double cz = mag2 == 0.0 ? sz : gz * scale;
+    // §3: F_n = k_n δ_o; F*_s = F_s,o − k_s Δδ_s; Coulomb clamp at μ F_n.
+    const double normal_rate = rx * nx + ry * ny + rz * nz;
+    const double srx = rx - nx * normal_rate, sry = ry - ny * normal_rate, srz = rz - nz * normal_rate;
+    const double fn = kn[i] * -g;
+    const double inc = ks[i] * dt;
+    const double ux = cx - srx * inc, uy = cy - sry * inc, uz = cz - srz * inc;
+    const double limit = fric[i] * fn;
+    const double mag = std::sqrt(ux * ux + uy * uy + uz * uz);
+    const double clamp = mag <= limit ? 1.0 : limit / mag;
+    const double fsx = mag <= limit ? ux : ux * clamp;
+    const double fsy = mag <= limit ? uy : uy * clamp;
+    const double fsz = mag <= limit ? uz : uz * clamp;
+    const double fx = active ? nx * fn + fsx : 0.0;
+    const double fy = active ? ny * fn + fsy : 0.0;
+    const double fz = active ? nz * fn + fsz : 0.0;
+    force.x[i] = fx, force.y[i] = fy, force.z[i] = fz;
+    shear.x[i] = active ? fsx : 0.0, shear.y[i] = active ? fsy : 0.0, shear.z[i] = active ? fsz : 0.0;
+    torque.x[i] = ny * fz - nz * fy, torque.y[i] = nz * fx - nx * fz, torque.z[i] = nx * fy - ny * fx;
+    fn_out[i] = active ? fn : 0.0;
+    fm_out[i] = 0.0;
+    trial_out[i] = active ? mag : 0.0;
+    active_out[i] = active ? 1.0 : 0.0;
+    ruptured[i] = 0.0;
+    if (want_stiffness) {
+      k_tran[i] = active ? kn[i] + ks[i] : 0.0;
+      k_shear[i] = active ? ks[i] : 0.0;
     }
   }
 }
