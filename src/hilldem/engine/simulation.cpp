@@ -164,10 +164,20 @@ void Simulation::wrap_positions() {
 void Simulation::rebuild_if_needed() {
   if (!rebuild_needed_ && position_at_build_.size() == balls.size()) {
     const double half = 0.5 * skin();
+    // Largest squared travel since the rebuild [m²]; a NaN wins (not std::max, which would drop it).
+    // Parallel: the maximum does not depend on the order, and any NaN ends the run below.
+    const std::size_t n = balls.size();
     double worst = 0.0;
-    for (std::size_t i = 0; i < balls.size(); ++i) {
-      const double d2 = norm2(balls.position[i] - position_at_build_[i]);
-      if (!(d2 <= worst)) worst = d2;  // not std::max, which would drop a NaN
+#pragma omp parallel if (n > kParallelMin)
+    {
+      double mine = 0.0;
+#pragma omp for schedule(static) nowait
+      for (std::size_t i = 0; i < n; ++i) {
+        const double d2 = norm2(balls.position[i] - position_at_build_[i]);
+        if (!(d2 <= mine)) mine = d2;
+      }
+#pragma omp critical(hilldem_rebuild_check)
+      if (!(mine <= worst)) worst = mine;
     }
     if (!std::isfinite(worst)) {
       for (std::size_t i = 0; i < balls.size(); ++i)
