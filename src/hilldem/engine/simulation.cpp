@@ -302,6 +302,9 @@ void Simulation::restore_cycle_state(CycleState s) {
     if (k.a >= balls.size() || (k.kind == ContactKind::BallBall && k.b >= balls.size()) ||
         (k.kind == ContactKind::BallWall && k.b >= walls.size()))
       throw RunError("cycle state: a contact row refers to a body that does not exist");
+  // The force pass finds a ball's rows by position in the sorted list (first_rows_).
+  for (std::size_t c = 1; c < contacts.size(); ++c)
+    if (!(contacts.key[c - 1] < contacts.key[c])) throw RunError("cycle state: contact rows are not sorted by key");
   forces_ready_ = s.forces_ready;
   rebuild_needed_ = s.rebuild_needed || s.position_at_build.empty();
   rebuilds_ = s.rebuilds;

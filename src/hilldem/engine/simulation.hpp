@@ -156,8 +156,6 @@ class Simulation {
   // share_moment_, the moment on the body that collects the row after the pass (piece 2 of a ball-ball
   // row, the ball of a ball-wall row).
   RowShare force_row(std::size_t c, double dt);
-  // The rows of balls a0..a1-1 (ball-ball), with their half of the force sum; bad_row: the lowest
-  // row with a non-finite force.
   // What one thread reuses from block to block.
   struct BlockScratch {
     ContactBatch hill, linear;
