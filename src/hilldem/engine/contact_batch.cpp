@@ -43,14 +43,74 @@ void batch_geometry(ContactBatch& batch) {
   }
 }
 
+// What every law reads of a lane besides its parameters.
+struct LaneInputs {
+  Cols n_new, n_old, s_old, va, vb, wa, wb;
+  const double* __restrict r1;
+  const double* __restrict r2;
+  const double* __restrict gap;
+  explicit LaneInputs(ContactBatch& b)
+      : n_new(cols(b, ContactBatch::kNx)), n_old(cols(b, ContactBatch::kNox)), s_old(cols(b, ContactBatch::kSx)),
+        va(cols(b, ContactBatch::kVax)), vb(cols(b, ContactBatch::kVbx)), wa(cols(b, ContactBatch::kWax)),
+        wb(cols(b, ContactBatch::kWbx)), r1(b.col(ContactBatch::kR1)), r2(b.col(ContactBatch::kR2)),
+        gap(b.col(ContactBatch::kGap)) {}
+};
+
+// Lane i's relative velocity at the contact point split into normal and shear rates (§1.2:
+// ẋ_c(2) − ẋ_c(1), ẋ_c(1) = v1 + ω1 × (R1 + g/2) n̂, ẋ_c(2) = v2 − ω2 × (R2 + g/2) n̂), and its stored
+// shear force carried into the current plane (PlaneRotation::carry, §1.3: (a) tilt n_old × n̂,
+// (b) twist n̂ ½(ω1 + ω2)·n̂ Δt, (c) the normal part dropped and the magnitude restored). In
+// components, every branch a select, so that the callers' loops vectorise (GCC 12 gives up on
+// selects between Vec3 temporaries).
+struct LaneMotion {
+  double normal_rate;  // δ̇_n [m/s], > 0 apart
+  double srx, sry, srz;  // δ̇_s [m/s]
+  double cx, cy, cz;     // stored shear force in the current plane [N]
+};
+
+HILLDEM_INLINE LaneMotion lane_motion(const LaneInputs& in, std::size_t i, double dt) {
+  const double nx = in.n_new.x[i], ny = in.n_new.y[i], nz = in.n_new.z[i];
+  const double g = in.gap[i];
+  const double wax = in.wa.x[i], way = in.wa.y[i], waz = in.wa.z[i];
+  const double wbx = in.wb.x[i], wby = in.wb.y[i], wbz = in.wb.z[i];
+  const double arm1 = in.r1[i] + 0.5 * g, arm2 = in.r2[i] + 0.5 * g;
+  const double ax = nx * arm1, ay = ny * arm1, az = nz * arm1;
+  const double bx = nx * arm2, by = ny * arm2, bz = nz * arm2;
+  const double v1x = in.va.x[i] + (way * az - waz * ay);
+  const double v1y = in.va.y[i] + (waz * ax - wax * az);
+  const double v1z = in.va.z[i] + (wax * ay - way * ax);
+  const double v2x = in.vb.x[i] - (wby * bz - wbz * by);
+  const double v2y = in.vb.y[i] - (wbz * bx - wbx * bz);
+  const double v2z = in.vb.z[i] - (wbx * by - wby * bx);
+  const double rx = v2x - v1x, ry = v2y - v1y, rz = v2z - v1z;
+  const double ox = in.n_old.x[i], oy = in.n_old.y[i], oz = in.n_old.z[i];
+  const double tx = oy * nz - oz * ny, ty = oz * nx - ox * nz, tz = ox * ny - oy * nx;
+  const double spin = 0.5 * ((wax + wbx) * nx + (way + wby) * ny + (waz + wbz) * nz) * dt;
+  const double qx = nx * spin, qy = ny * spin, qz = nz * spin;
+  const double sx = in.s_old.x[i], sy = in.s_old.y[i], sz = in.s_old.z[i];
+  const double mag2 = sx * sx + sy * sy + sz * sz;
+  const double g1x = sx - (sy * tz - sz * ty), g1y = sy - (sz * tx - sx * tz), g1z = sz - (sx * ty - sy * tx);
+  double gx = g1x - (g1y * qz - g1z * qy), gy = g1y - (g1z * qx - g1x * qz), gz = g1z - (g1x * qy - g1y * qx);
+  const double gn = gx * nx + gy * ny + gz * nz;
+  gx = gx - nx * gn, gy = gy - ny * gn, gz = gz - nz * gn;
+  const double g2 = gx * gx + gy * gy + gz * gz;
+  const double scale = g2 > 0.0 ? std::sqrt(mag2 / g2) : 1.0;
+  const double normal_rate = rx * nx + ry * ny + rz * nz;
+  return {normal_rate,
+          rx - nx * normal_rate,
+          ry - ny * normal_rate,
+          rz - nz * normal_rate,
+          mag2 == 0.0 ? sx : gx * scale,
+          mag2 == 0.0 ? sy : gy * scale,
+          mag2 == 0.0 ? sz : gz * scale};
+}
+
 }  // namespace
 
 void hill_batch_forces(ContactBatch& batch, double dt, bool want_stiffness) {
   using F = ContactBatch;
   const std::size_t n = batch.size();
-  const Cols va = cols(batch, F::kVax), vb = cols(batch, F::kVbx);
-  const Cols wa = cols(batch, F::kWax), wb = cols(batch, F::kWbx), n_old = cols(batch, F::kNox);
-  const Cols s_old = cols(batch, F::kSx), n_new = cols(batch, F::kNx), force = cols(batch, F::kFx);
+  const Cols n_new = cols(batch, F::kNx), force = cols(batch, F::kFx);
   const Cols shear = cols(batch, F::kShx), torque = cols(batch, F::kTx);
   const double* __restrict r1 = batch.col(F::kR1);
   const double* __restrict r2 = batch.col(F::kR2);
@@ -103,8 +163,8 @@ void hill_batch_forces(ContactBatch& batch, double dt, bool want_stiffness) {
   }
 
   // 3. Kinematics (§1.2), plane rotation (§1.3) and the law (Eqs. 13-18, 19-21), written out in
-  // components with every branch a select, so that the loop vectorises (GCC gives up on selects
-  // between Vec3 temporaries).
+  // components with every branch a select, so that the loop vectorises.
+  const LaneInputs in(batch);
 #pragma omp simd
   for (std::size_t i = 0; i < n; ++i) {
     const double nx = n_new.x[i], ny = n_new.y[i], nz = n_new.z[i];
@@ -112,39 +172,10 @@ void hill_batch_forces(ContactBatch& batch, double dt, bool want_stiffness) {
     // Active: wet, or overlapping (spec §2.5), and not ruptured this step. As a comparison of doubles,
     // not a bool combination, which GCC 12 will not vectorise.
     const bool active = (wet[i] + (g <= 0.0 ? 1.0 : 0.0)) * (1.0 - ruptured[i]) > 0.0;
-    const double wax = wa.x[i], way = wa.y[i], waz = wa.z[i];
-    const double wbx = wb.x[i], wby = wb.y[i], wbz = wb.z[i];
-    // ẋ_c(1) = v1 + ω1 × (R1 + g/2) n̂,  ẋ_c(2) = v2 − ω2 × (R2 + g/2) n̂  (§1.2)
-    const double arm1 = r1[i] + 0.5 * g, arm2 = r2[i] + 0.5 * g;
-    const double ax = nx * arm1, ay = ny * arm1, az = nz * arm1;
-    const double bx = nx * arm2, by = ny * arm2, bz = nz * arm2;
-    const double v1x = va.x[i] + (way * az - waz * ay);
-    const double v1y = va.y[i] + (waz * ax - wax * az);
-    const double v1z = va.z[i] + (wax * ay - way * ax);
-    const double v2x = vb.x[i] - (wby * bz - wbz * by);
-    const double v2y = vb.y[i] - (wbz * bx - wbx * bz);
-    const double v2z = vb.z[i] - (wbx * by - wby * bx);
-    const double rx = v2x - v1x, ry = v2y - v1y, rz = v2z - v1z;
-    // Carry F^h_s into the current plane (PlaneRotation::carry): (a) tilt n_old × n̂, (b) twist
-    // n̂ ½(ω1 + ω2)·n̂ Δt, (c) drop the normal part and restore the magnitude.
-    const double ox = n_old.x[i], oy = n_old.y[i], oz = n_old.z[i];
-    const double tx = oy * nz - oz * ny, ty = oz * nx - ox * nz, tz = ox * ny - oy * nx;
-    const double spin = 0.5 * ((wax + wbx) * nx + (way + wby) * ny + (waz + wbz) * nz) * dt;
-    const double qx = nx * spin, qy = ny * spin, qz = nz * spin;
-    const double sx = s_old.x[i], sy = s_old.y[i], sz = s_old.z[i];
-    const double mag2 = sx * sx + sy * sy + sz * sz;
-    const double g1x = sx - (sy * tz - sz * ty), g1y = sy - (sz * tx - sx * tz), g1z = sz - (sx * ty - sy * tx);
-    double gx = g1x - (g1y * qz - g1z * qy), gy = g1y - (g1z * qx - g1x * qz), gz = g1z - (g1x * qy - g1y * qx);
-    const double gn = gx * nx + gy * ny + gz * nz;
-    gx = gx - nx * gn, gy = gy - ny * gn, gz = gz - nz * gn;
-    const double g2 = gx * gx + gy * gy + gz * gz;
-    const double scale = g2 > 0.0 ? std::sqrt(mag2 / g2) : 1.0;
-    const double cx = mag2 == 0.0 ? sx : gx * scale;
-    const double cy = mag2 == 0.0 ? sy : gy * scale;
-    const double cz = mag2 == 0.0 ? sz : gz * scale;
-    // Eq. 13: Hertz normal force with the δ^{1/4} dashpot.
-    const double normal_rate = rx * nx + ry * ny + rz * nz;
-    const double srx = rx - nx * normal_rate, sry = ry - ny * normal_rate, srz = rz - nz * normal_rate;
+    const LaneMotion mo = lane_motion(in, i, dt);
+    const double normal_rate = mo.normal_rate;
+    const double srx = mo.srx, sry = mo.sry, srz = mo.srz;
+    const double cx = mo.cx, cy = mo.cy, cz = mo.cz;
     const double overlap = -g;
     const bool touching = overlap > 0.0;
     const double root2 = touching ? std::sqrt(overlap) : 0.0;
@@ -200,12 +231,8 @@ void linear_batch_forces(ContactBatch& batch, double dt, bool want_stiffness) {
   using F = ContactBatch;
   const std::size_t n = batch.size();
   batch_geometry(batch);
-  const Cols va = cols(batch, F::kVax), vb = cols(batch, F::kVbx), wa = cols(batch, F::kWax);
-  const Cols wb = cols(batch, F::kWbx), n_old = cols(batch, F::kNox), s_old = cols(batch, F::kSx);
   const Cols n_new = cols(batch, F::kNx), force = cols(batch, F::kFx), shear = cols(batch, F::kShx);
   const Cols torque = cols(batch, F::kTx);
-  const double* __restrict r1 = batch.col(F::kR1);
-  const double* __restrict r2 = batch.col(F::kR2);
   const double* __restrict kn = batch.col(F::kIr1);
   const double* __restrict ks = batch.col(F::kIr2);
   const double* __restrict fric = batch.col(F::kFric);
@@ -218,41 +245,15 @@ void linear_batch_forces(ContactBatch& batch, double dt, bool want_stiffness) {
   double* __restrict k_tran = batch.col(F::kKtran);
   double* __restrict k_shear = batch.col(F::kKshear);
   // Kinematics (§1.2), plane rotation (§1.3) and the linear law (§3), in components (see above).
+  const LaneInputs in(batch);
 #pragma omp simd
   for (std::size_t i = 0; i < n; ++i) {
     const double nx = n_new.x[i], ny = n_new.y[i], nz = n_new.z[i];
     const double g = gap[i];
     const bool active = g < 0.0;  // overlapping; no tension, no reference gap
-    const double wax = wa.x[i], way = wa.y[i], waz = wa.z[i];
-    const double wbx = wb.x[i], wby = wb.y[i], wbz = wb.z[i];
-    const double arm1 = r1[i] + 0.5 * g, arm2 = r2[i] + 0.5 * g;
-    const double ax = nx * arm1, ay = ny * arm1, az = nz * arm1;
-    const double bx = nx * arm2, by = ny * arm2, bz = nz * arm2;
-    const double v1x = va.x[i] + (way * az - waz * ay);
-    const double v1y = va.y[i] + (waz * ax - wax * az);
-    const double v1z = va.z[i] + (wax * ay - way * ax);
-    const double v2x = vb.x[i] - (wby * bz - wbz * by);
-    const double v2y = vb.y[i] - (wbz * bx - wbx * bz);
-    const double v2z = vb.z[i] - (wbx * by - wby * bx);
-    const double rx = v2x - v1x, ry = v2y - v1y, rz = v2z - v1z;
-    const double ox = n_old.x[i], oy = n_old.y[i], oz = n_old.z[i];
-    const double tx = oy * nz - oz * ny, ty = oz * nx - ox * nz, tz = ox * ny - oy * nx;
-    const double spin = 0.5 * ((wax + wbx) * nx + (way + wby) * ny + (waz + wbz) * nz) * dt;
-    const double qx = nx * spin, qy = ny * spin, qz = nz * spin;
-    const double sx = s_old.x[i], sy = s_old.y[i], sz = s_old.z[i];
-    const double mag2 = sx * sx + sy * sy + sz * sz;
-    const double g1x = sx - (sy * tz - sz * ty), g1y = sy - (sz * tx - sx * tz), g1z = sz - (sx * ty - sy * tx);
-    double gx = g1x - (g1y * qz - g1z * qy), gy = g1y - (g1z * qx - g1x * qz), gz = g1z - (g1x * qy - g1y * qx);
-    const double gn = gx * nx + gy * ny + gz * nz;
-    gx = gx - nx * gn, gy = gy - ny * gn, gz = gz - nz * gn;
-    const double g2 = gx * gx + gy * gy + gz * gz;
-    const double scale = g2 > 0.0 ? std::sqrt(mag2 / g2) : 1.0;
-    const double cx = mag2 == 0.0 ? sx : gx * scale;
-    const double cy = mag2 == 0.0 ? sy : gy * scale;
-    const double cz = mag2 == 0.0 ? sz : gz * scale;
-    // §3: F_n = k_n δ_o; F*_s = F_s,o − k_s Δδ_s; Coulomb clamp at μ F_n.
-    const double normal_rate = rx * nx + ry * ny + rz * nz;
-    const double srx = rx - nx * normal_rate, sry = ry - ny * normal_rate, srz = rz - nz * normal_rate;
+    const LaneMotion mo = lane_motion(in, i, dt);
+    const double srx = mo.srx, sry = mo.sry, srz = mo.srz;
+    const double cx = mo.cx, cy = mo.cy, cz = mo.cz;
     const double fn = kn[i] * -g;
     const double inc = ks[i] * dt;
     const double ux = cx - srx * inc, uy = cy - sry * inc, uz = cz - srz * inc;
