@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <tuple>
 
 #include "sim_builders.hpp"
 
@@ -55,6 +56,36 @@ TEST(HillBatch, SameMotionAsTheRowByRowLawWetAndDry) {
   EXPECT_EQ(batch.ruptured, rows.ruptured);
   EXPECT_GT(batch.wet, 0u);
   EXPECT_LT(worst_position_gap(batch, rows), 1e-12);  // radii 2-3 mm: rounding only
+}
+
+// A periodic box (x, y, z; no walls) of 400 fast wet grains, shifted so that the boundaries cut the
+// cloud: contacts across the boundaries (periodic images in the gather) and positions wrapped at
+// rebuilds; the same motion either way.
+TEST(HillBatch, SameMotionInAPeriodicBox) {
+  auto run = [](bool batched) {
+    Simulation sim = random_box(400, 8, /*walls=*/false);
+    sim.settings.box.periodic[0] = sim.settings.box.periodic[1] = sim.settings.box.periodic[2] = true;
+    sim.settings.box.hi = {0.04, 0.04, 0.04};
+    for (std::size_t i = 0; i < sim.balls.size(); ++i) {
+      sim.balls.velocity[i] *= 10.0;  // [m/s]
+      sim.balls.position[i] += Vec3{0.02, 0.013, 0.0};  // [m] the x and y boundaries now cut the cloud
+    }
+    sim.use_batched_kernel = batched;
+    sim.make_wet(20e3, 0.5e-3);  // (its rebuild wraps the positions into the box)
+    std::size_t across = 0;
+    for (std::size_t c = 0; c < sim.contacts.size(); ++c) across += sim.contacts.exists[c] && sim.contacts.image[c] != kNoImage;
+    sim.cycle(400);
+    return std::make_tuple(outcome(sim), sim.rebuilds(), across);
+  };
+  const auto [batch, batch_rebuilds, across] = run(true);
+  const auto [rows, rows_rebuilds, rows_across] = run(false);
+  EXPECT_GT(across, 20u);  // wet contacts across the boundaries, through the batch with their image
+  EXPECT_EQ(across, rows_across);
+  EXPECT_GT(batch.batched, 50);
+  EXPECT_GT(batch_rebuilds, 2);  // rebuilt (and wrapped) on the way
+  EXPECT_EQ(batch_rebuilds, rows_rebuilds);
+  EXPECT_EQ(batch.contacts, rows.contacts);
+  EXPECT_LT(worst_position_gap(batch, rows), 1e-12);
 }
 
 // Two wet grains pulled apart: the bridge holds, then ruptures at 2 s_cr (Eq. 12), at the same step
