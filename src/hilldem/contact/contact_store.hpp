@@ -53,7 +53,7 @@ class ContactStore {
 
   // Results of the last force-displacement pass
   // Only what the cycle needs is stored (each column costs memory traffic on every step): the shear
-  // force and the moment are derived from these (shear_force(), and n̂_c × F_c in collect_forces()).
+  // force is derived from these (shear_force()), the moments from n̂_c × F_c in the force pass.
   std::vector<double> gap;             // g_c [m]
   std::vector<Vec3> force;             // F_c = (F_n + F^m) n̂_c + F_s on piece 2 [N]
   std::vector<double> normal_force;    // F_n (linear) or F^s_n (hill) [N], compression positive

@@ -4,8 +4,10 @@
 //   3. contact detection and resolution at the new positions: the neighbour list (pairs within
 //      proximity + skin) is rebuilt only when something moved more than half the skin, history
 //      kept by a sorted merge; contacts are created and deleted on it by proximity,
-//   4. force-displacement law of every contact -> forces at t+Δt, summed per body in a fixed order
-//      (per-ball row lists), so results are bitwise identical for any number of threads.
+//   4. force-displacement law of every contact -> forces at t+Δt (existing ball-ball contacts in
+//      vectorised batches, engine/contact_batch.hpp), summed per body in a fixed order (first-ball
+//      rows in the pair loop, then per-ball lists of the rest), so results are bitwise identical for
+//      any number of threads.
 // Lab-test drivers and the scenario runner use only this public API.
 #pragma once
 
