@@ -105,13 +105,39 @@ HILLDEM_INLINE LaneMotion lane_motion(const LaneInputs& in, std::size_t i, doubl
           mag2 == 0.0 ? sz : gz * scale};
 }
 
+// What every law writes of a lane besides the stiffnesses and the rupture flag.
+struct LaneOutputs {
+  Cols force, shear;
+  double* __restrict normal_force;
+  double* __restrict moisture_force;
+  double* __restrict trial;
+  double* __restrict active;
+  explicit LaneOutputs(ContactBatch& b)
+      : force(cols(b, ContactBatch::kFx)), shear(cols(b, ContactBatch::kShx)), normal_force(b.col(ContactBatch::kFn)),
+        moisture_force(b.col(ContactBatch::kFm)), trial(b.col(ContactBatch::kTrial)), active(b.col(ContactBatch::kActive)) {}
+};
+
+// Lane i's results: F_c = (normal part) n̂ + F_s, and the shear force h carried to the next step. An
+// inactive contact gives no force and forgets its shear force (hill Eq. 16 with F^μ_s = 0; linear §3).
+HILLDEM_INLINE void store_lane(const LaneOutputs& o, std::size_t i, bool active, double nx, double ny, double nz,
+                               double normal_part, double fsx, double fsy, double fsz, double hx, double hy, double hz,
+                               double fn, double fm, double trial) {
+  o.force.x[i] = active ? nx * normal_part + fsx : 0.0;
+  o.force.y[i] = active ? ny * normal_part + fsy : 0.0;
+  o.force.z[i] = active ? nz * normal_part + fsz : 0.0;
+  o.shear.x[i] = active ? hx : 0.0, o.shear.y[i] = active ? hy : 0.0, o.shear.z[i] = active ? hz : 0.0;
+  o.normal_force[i] = active ? fn : 0.0;
+  o.moisture_force[i] = active ? fm : 0.0;
+  o.trial[i] = active ? trial : 0.0;
+  o.active[i] = active ? 1.0 : 0.0;
+}
+
 }  // namespace
 
 void hill_batch_forces(ContactBatch& batch, double dt, bool want_stiffness) {
   using F = ContactBatch;
   const std::size_t n = batch.size();
-  const Cols n_new = cols(batch, F::kNx), force = cols(batch, F::kFx);
-  const Cols shear = cols(batch, F::kShx), torque = cols(batch, F::kTx);
+  const Cols n_new = cols(batch, F::kNx);
   const double* __restrict r1 = batch.col(F::kR1);
   const double* __restrict r2 = batch.col(F::kR2);
   double* __restrict kn = batch.col(F::kKn);
@@ -124,10 +150,7 @@ void hill_batch_forces(ContactBatch& batch, double dt, bool want_stiffness) {
   const double* __restrict damp = batch.col(F::kDamp);
   const double* __restrict wet = batch.col(F::kWet);
   double* __restrict gap = batch.col(F::kGap);
-  double* __restrict fn_out = batch.col(F::kFn);
   double* __restrict fm_out = batch.col(F::kFm);
-  double* __restrict trial_out = batch.col(F::kTrial);
-  double* __restrict active_out = batch.col(F::kActive);
   double* __restrict ruptured = batch.col(F::kRuptured);
   double* __restrict k_tran = batch.col(F::kKtran);
   double* __restrict k_shear = batch.col(F::kKshear);
@@ -165,6 +188,7 @@ void hill_batch_forces(ContactBatch& batch, double dt, bool want_stiffness) {
   // 3. Kinematics (§1.2), plane rotation (§1.3) and the law (Eqs. 13-18, 19-21), written out in
   // components with every branch a select, so that the loop vectorises.
   const LaneInputs in(batch);
+  const LaneOutputs out(batch);
 #pragma omp simd
   for (std::size_t i = 0; i < n; ++i) {
     const double nx = n_new.x[i], ny = n_new.y[i], nz = n_new.z[i];
@@ -201,18 +225,7 @@ void hill_batch_forces(ContactBatch& batch, double dt, bool want_stiffness) {
     const double fsy = touching ? (t_mag <= strength ? ey : ey * slip) : 0.0;
     const double fsz = touching ? (t_mag <= strength ? ez : ez * slip) : 0.0;
     const double fm = fm_out[i];
-    const double fnm = fn + fm;
-    // An inactive contact gives no force and forgets its shear force (Eq. 16 with F^μ_s = 0).
-    const double fx = active ? nx * fnm + fsx : 0.0;
-    const double fy = active ? ny * fnm + fsy : 0.0;
-    const double fz = active ? nz * fnm + fsz : 0.0;
-    force.x[i] = fx, force.y[i] = fy, force.z[i] = fz;
-    shear.x[i] = active ? hx : 0.0, shear.y[i] = active ? hy : 0.0, shear.z[i] = active ? hz : 0.0;
-    torque.x[i] = ny * fz - nz * fy, torque.y[i] = nz * fx - nx * fz, torque.z[i] = nx * fy - ny * fx;
-    fn_out[i] = active ? fn : 0.0;
-    fm_out[i] = active ? fm : 0.0;
-    trial_out[i] = active ? trial : 0.0;
-    active_out[i] = active ? 1.0 : 0.0;
+    store_lane(out, i, active, nx, ny, nz, fn + fm, fsx, fsy, fsz, hx, hy, hz, fn, fm, trial);
     if (want_stiffness) {  // Eqs. 19-21 (hill_timestep_stiffness)
       const double ov = overlap <= 0.0 ? kHillTimestepOverlapFactor * ro[i] : overlap;
       const double sr = std::sqrt(ov);
@@ -231,21 +244,17 @@ void linear_batch_forces(ContactBatch& batch, double dt, bool want_stiffness) {
   using F = ContactBatch;
   const std::size_t n = batch.size();
   batch_geometry(batch);
-  const Cols n_new = cols(batch, F::kNx), force = cols(batch, F::kFx), shear = cols(batch, F::kShx);
-  const Cols torque = cols(batch, F::kTx);
+  const Cols n_new = cols(batch, F::kNx);
   const double* __restrict kn = batch.col(F::kIr1);
   const double* __restrict ks = batch.col(F::kIr2);
   const double* __restrict fric = batch.col(F::kFric);
   const double* __restrict gap = batch.col(F::kGap);
-  double* __restrict fn_out = batch.col(F::kFn);
-  double* __restrict fm_out = batch.col(F::kFm);
-  double* __restrict trial_out = batch.col(F::kTrial);
-  double* __restrict active_out = batch.col(F::kActive);
   double* __restrict ruptured = batch.col(F::kRuptured);
   double* __restrict k_tran = batch.col(F::kKtran);
   double* __restrict k_shear = batch.col(F::kKshear);
   // Kinematics (§1.2), plane rotation (§1.3) and the linear law (§3), in components (see above).
   const LaneInputs in(batch);
+  const LaneOutputs out(batch);
 #pragma omp simd
   for (std::size_t i = 0; i < n; ++i) {
     const double nx = n_new.x[i], ny = n_new.y[i], nz = n_new.z[i];
@@ -263,16 +272,7 @@ void linear_batch_forces(ContactBatch& batch, double dt, bool want_stiffness) {
     const double fsx = mag <= limit ? ux : ux * clamp;
     const double fsy = mag <= limit ? uy : uy * clamp;
     const double fsz = mag <= limit ? uz : uz * clamp;
-    const double fx = active ? nx * fn + fsx : 0.0;
-    const double fy = active ? ny * fn + fsy : 0.0;
-    const double fz = active ? nz * fn + fsz : 0.0;
-    force.x[i] = fx, force.y[i] = fy, force.z[i] = fz;
-    shear.x[i] = active ? fsx : 0.0, shear.y[i] = active ? fsy : 0.0, shear.z[i] = active ? fsz : 0.0;
-    torque.x[i] = ny * fz - nz * fy, torque.y[i] = nz * fx - nx * fz, torque.z[i] = nx * fy - ny * fx;
-    fn_out[i] = active ? fn : 0.0;
-    fm_out[i] = 0.0;
-    trial_out[i] = active ? mag : 0.0;
-    active_out[i] = active ? 1.0 : 0.0;
+    store_lane(out, i, active, nx, ny, nz, fn, fsx, fsy, fsz, fsx, fsy, fsz, fn, 0.0, mag);
     ruptured[i] = 0.0;
     if (want_stiffness) {
       k_tran[i] = active ? kn[i] + ks[i] : 0.0;

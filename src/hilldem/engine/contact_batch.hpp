@@ -46,7 +46,6 @@ class ContactBatch {
     kActive,            // 1 if active after the step
     kRuptured,          // 1 if the liquid bridge ruptured this step
     kKtran, kKshear,    // k̂_n + k̂_s, k̂_s [N/m] (when asked for)
-    kTx, kTy, kTz,      // n̂_c × F_c [N]
     kFieldCount
   };
 

@@ -367,59 +367,68 @@ Simulation::RowShare Simulation::force_row(std::size_t c, double dt) {
   const PlaneRotation rotation(contacts.normal[c], normal, 0.5 * dot(balls.spin[a] + spin2, normal), dt);
   const ContactKinematics kin{normal, gap, v2 - v1, dt};
 
-  Vec3 force;
-  double fn = 0.0, fm = 0.0, trial = 0.0;
-  bool active = false;
+  RowOutcome out;
+  out.normal = normal;
+  out.gap = gap;
+  out.arm1 = arm1;
+  out.arm2 = ball2 ? rad[key.b] + 0.5 * gap : arm1;  // a wall row is collected by its ball
+  out.moisture = contacts.moisture[c];
   StiffnessEstimate stiff;
-  Moisture moisture = contacts.moisture[c];
   if (contacts.model[c] == ModelKind::Hill) {
     const HillState prev{rotation.carry(contacts.shear_state[c]), contacts.moisture[c]};
     const HillResult r = hill_force(contacts.hill_params[c], contacts.hill_map[c], kin, prev);
-    contacts.shear_state[c] = r.state.shear_hm;
-    moisture = r.state.moisture;
-    force = r.force, fn = r.surface_normal, fm = r.moisture_force;
-    trial = r.trial_shear, active = r.active;
-    if (active && want_stiffness) stiff = hill_timestep_stiffness(contacts.hill_params[c], contacts.hill_map[c], gap);
+    out.shear = r.state.shear_hm;
+    out.moisture = r.state.moisture;
+    out.force = r.force, out.normal_force = r.surface_normal, out.moisture_force = r.moisture_force;
+    out.trial_shear = r.trial_shear, out.active = r.active;
+    if (out.active && want_stiffness) stiff = hill_timestep_stiffness(contacts.hill_params[c], contacts.hill_map[c], gap);
   } else {
     const LinearState prev{rotation.carry(contacts.shear_state[c])};
     const LinearResult r = linear_force(contacts.linear_params[c], contacts.linear_map[c], kin, prev);
-    contacts.shear_state[c] = r.state.shear_force;
-    force = r.force, fn = r.normal_force, trial = r.trial_shear, active = r.active;
-    if (active) stiff = {contacts.linear_map[c].kn, contacts.linear_map[c].ks};
+    out.shear = r.state.shear_force;
+    out.force = r.force, out.normal_force = r.normal_force, out.trial_shear = r.trial_shear, out.active = r.active;
+    if (out.active) stiff = {contacts.linear_map[c].kn, contacts.linear_map[c].ks};
   }
+  out.k_tran = stiff.kn + stiff.ks;
+  out.k_shear = stiff.ks;
+  if (!out.active) out.force = Vec3{};
+  // Accumulated shear displacement (reported, not used by the laws): rotated with the plane (and
+  // cleared again by store_row if the contact is deleted).
+  if (settings.track_shear_displacement)
+    contacts.shear_disp[c] = out.active ? rotation.rotate(contacts.shear_disp[c]) + kin.shear_rate() * dt : Vec3{};
+  return store_row(c, out, want_stiffness);
+}
+
+HILLDEM_INLINE Simulation::RowShare Simulation::store_row(std::size_t c, const RowOutcome& out, bool want_stiffness) {
   // Deleted when inactive beyond the proximity distance (a wet contact stays active: spec §2.5).
-  if (!active && gap > proximity) {
+  if (!out.active && out.gap > settings.proximity) {
     contacts.remove(c);  // (moisture back to dry)
-    contacts.gap[c] = gap;
-    contacts.normal[c] = normal;
+    contacts.gap[c] = out.gap;
+    contacts.normal[c] = out.normal;
     share_moment_[c] = Vec3{};
     return {};
   }
-  // Accumulated shear displacement (reported, not used by the laws): rotated with the plane.
-  if (settings.track_shear_displacement)
-    contacts.shear_disp[c] = active ? rotation.rotate(contacts.shear_disp[c]) + kin.shear_rate() * dt : Vec3{};
-  // Only the columns the cycle needs (memory traffic): F_s = F_c − (F_n + F^m) n̂ is derived.
-  if (!active) force = Vec3{};
   // Force on piece 2 is F_c, on piece 1 −F_c (spec conventions). The contact point lies on the normal
   // at R + g/2 from either centre, so the moment on either ball is −(R + g/2) n̂ × F_c.
-  const Vec3 torque = cross(normal, force);
-  RowShare share{-force, torque * -arm1, true};
-  share_moment_[c] = ball2 ? torque * -(rad[key.b] + 0.5 * gap) : share.moment;
-  contacts.normal[c] = normal;
-  contacts.gap[c] = gap;
-  contacts.force[c] = force;
-  contacts.normal_force[c] = fn;
-  contacts.moisture_force[c] = fm;
-  contacts.trial_shear[c] = trial;
+  const Vec3 torque = cross(out.normal, out.force);
+  const RowShare share{-out.force, torque * -out.arm1, std::isfinite(out.force.x + out.force.y + out.force.z)};
+  share_moment_[c] = torque * -out.arm2;
+  // Only the columns the cycle needs (memory traffic): F_s = F_c − (F_n + F^m) n̂ is derived.
+  contacts.shear_state[c] = out.shear;
+  contacts.normal[c] = out.normal;
+  contacts.gap[c] = out.gap;
+  contacts.force[c] = out.force;
+  contacts.normal_force[c] = out.normal_force;
+  contacts.moisture_force[c] = out.moisture_force;
+  contacts.trial_shear[c] = out.trial_shear;
   if (want_stiffness) {  // only the time-step estimate and density scaling read them
-    contacts.k_tran[c] = stiff.kn + stiff.ks;
-    contacts.k_shear[c] = stiff.ks;
+    contacts.k_tran[c] = out.k_tran;
+    contacts.k_shear[c] = out.k_shear;
   }
   // Byte-sized columns last: a char store may alias anything, so the compiler reloads every
   // column pointer after one.
-  contacts.moisture[c] = moisture;
-  contacts.active[c] = active;
-  share.ok = std::isfinite(force.x + force.y + force.z);
+  contacts.moisture[c] = out.moisture;
+  contacts.active[c] = out.active;
   return share;
 }
 
@@ -458,35 +467,23 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, double dt, BlockScr
     batched_count += static_cast<std::int64_t>(batch.size());
     for (std::size_t lane = 0; lane < batch.size(); ++lane) {
       const std::size_t c = batch.row(lane);
-      const Vec3 normal = get3(batch, F::kNx, lane);
-      const double g = batch.col(F::kGap)[lane];
-      const bool active = batch.col(F::kActive)[lane] != 0.0;
-      if (!active && g > proximity) {  // deleted when inactive beyond proximity (§2.5)
-        contacts.remove(c);
-        contacts.gap[c] = g;
-        contacts.normal[c] = normal;
-        share_moment_[c] = Vec3{};
-        continue;
-      }
-      const Vec3 force = get3(batch, F::kFx, lane), torque = get3(batch, F::kTx, lane);
-      const double half_gap = 0.5 * g;
-      RowShare& share = shares[c - r0];
-      share = RowShare{-force, torque * -(batch.col(F::kR1)[lane] + half_gap), std::isfinite(force.x + force.y + force.z)};
+      RowOutcome out;
+      out.normal = get3(batch, F::kNx, lane);
+      out.gap = batch.col(F::kGap)[lane];
+      out.arm1 = batch.col(F::kR1)[lane] + 0.5 * out.gap;
+      out.arm2 = batch.col(F::kR2)[lane] + 0.5 * out.gap;
+      out.force = get3(batch, F::kFx, lane);
+      out.shear = get3(batch, F::kShx, lane);
+      out.normal_force = batch.col(F::kFn)[lane];
+      out.moisture_force = batch.col(F::kFm)[lane];
+      out.trial_shear = batch.col(F::kTrial)[lane];
+      out.k_tran = batch.col(F::kKtran)[lane];
+      out.k_shear = batch.col(F::kKshear)[lane];
+      out.moisture = batch.col(F::kRuptured)[lane] != 0.0 ? Moisture::Ruptured : contacts.moisture[c];
+      out.active = batch.col(F::kActive)[lane] != 0.0;
+      const RowShare share = store_row(c, out, want_stiffness);
       if (!share.ok) bad_row = std::min(bad_row, c);
-      share_moment_[c] = torque * -(batch.col(F::kR2)[lane] + half_gap);
-      contacts.shear_state[c] = get3(batch, F::kShx, lane);
-      contacts.normal[c] = normal;
-      contacts.gap[c] = g;
-      contacts.force[c] = force;
-      contacts.normal_force[c] = batch.col(F::kFn)[lane];
-      contacts.moisture_force[c] = batch.col(F::kFm)[lane];
-      contacts.trial_shear[c] = batch.col(F::kTrial)[lane];
-      if (want_stiffness) {
-        contacts.k_tran[c] = batch.col(F::kKtran)[lane];
-        contacts.k_shear[c] = batch.col(F::kKshear)[lane];
-      }
-      if (batch.col(F::kRuptured)[lane] != 0.0) contacts.moisture[c] = Moisture::Ruptured;
-      contacts.active[c] = active;
+      shares[c - r0] = share;
     }
     batch.clear();
   };

@@ -158,6 +158,21 @@ class Simulation {
   // share_moment_, the moment on the body that collects the row after the pass (piece 2 of a ball-ball
   // row, the ball of a ball-wall row).
   RowShare force_row(std::size_t c, double dt);
+  // A row's result, from either law path (row by row or batched).
+  struct RowOutcome {
+    Vec3 normal;                  // n̂_c
+    double gap = 0.0;             // g_c [m]
+    double arm1 = 0.0, arm2 = 0.0;  // R + g/2 [m] of the pair loop's ball and of the late-collecting body
+    Vec3 force;                   // F_c [N] (zero if inactive)
+    Vec3 shear;                   // shear force carried to the next step [N]
+    double normal_force = 0.0, moisture_force = 0.0, trial_shear = 0.0;  // [N]
+    double k_tran = 0.0, k_shear = 0.0;  // [N/m], written only when the time step needs them
+    Moisture moisture = Moisture::Dry;
+    bool active = false;
+  };
+  // Write a row's result into its columns, or delete the contact if it is inactive beyond proximity
+  // (spec §2.5); returns the pair loop's share.
+  RowShare store_row(std::size_t c, const RowOutcome& out, bool want_stiffness);
   // What one thread reuses from block to block.
   struct BlockScratch {
     ContactBatch hill, linear;
