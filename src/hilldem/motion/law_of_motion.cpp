@@ -1,12 +1,25 @@
 #include "hilldem/motion/law_of_motion.hpp"
 
+#include <bit>
+#include <cstdint>
+
 namespace hilldem {
 
 namespace {
 // F_d(i) = −α |F(i)| sign(V(i)) (spec §4), then ΔV = (F + F_d)/m Δt.
+// Written without branches: in a bed at rest the signs of the velocity components are random, and a
+// branch on each of them was mispredicted about every other time (advance_balls took 17 % of an
+// in-cache step, perf). Same values: sign ∈ {1, −1, 0} exactly as before.
+// (GCC turns a ?: between doubles into a branch, hence the bool-to-double conversions and bit masks.)
 inline double damped(double f, double v, double alpha) {
-  const double sign = v > 0.0 ? 1.0 : (v < 0.0 ? -1.0 : 0.0);
+  const double sign = static_cast<double>(v > 0.0) - static_cast<double>(v < 0.0);
   return f - alpha * std::abs(f) * sign;
+}
+// v + Δv unless the component is fixed, as a bit-mask select.
+inline double unless_fixed(bool fixed, double v, double dv) {
+  const std::uint64_t keep = std::uint64_t{0} - static_cast<std::uint64_t>(fixed);
+  return std::bit_cast<double>((std::bit_cast<std::uint64_t>(v) & keep) |
+                               (std::bit_cast<std::uint64_t>(v + dv) & ~keep));
 }
 }  // namespace
 
@@ -24,8 +37,8 @@ void advance_balls(BallStore& balls, const MotionSettings& s, double dt, const d
     Vec3& v = balls.velocity[i];
     Vec3& w = balls.spin[i];
     for (int d = 0; d < 3; ++d) {
-      if (!(fix & (1u << d))) v[d] += damped(f[d], v[d], alpha) * inv_m * dt;
-      if (!(fix & (1u << (d + 3)))) w[d] += damped(mo[d], w[d], alpha) * inv_i * dt;
+      v[d] = unless_fixed(fix & (1u << d), v[d], damped(f[d], v[d], alpha) * inv_m * dt);
+      w[d] = unless_fixed(fix & (1u << (d + 3)), w[d], damped(mo[d], w[d], alpha) * inv_i * dt);
     }
     balls.position[i] += v * dt;
   }
