@@ -145,6 +145,7 @@ void Simulation::create_contact(std::size_t c, const Vec3& normal) {
 }
 
 void Simulation::refresh_mappings() {
+  body_terms_ready_ = false;
   for (std::size_t c = 0; c < contacts.size(); ++c) compute_mapping(contacts, c);
 }
 
@@ -248,6 +249,7 @@ void Simulation::rebuild(double proximity) {
   position_at_build_ = balls.position;
   wall_travel_ = 0.0;
   rebuild_needed_ = false;
+  body_terms_ready_ = false;
   ++rebuilds_;
 }
 
@@ -311,6 +313,7 @@ void Simulation::restore_cycle_state(CycleState s) {
   unassigned_pairs_ = static_cast<std::size_t>(s.unassigned_pairs);
   position_at_build_ = std::move(s.position_at_build);
   wall_travel_ = s.wall_travel;
+  body_terms_ready_ = false;
   build_row_lists();
 }
 
@@ -578,22 +581,31 @@ void Simulation::force_pass(double dt) {
   const std::size_t blocks = (n + kBlock - 1) / kBlock;
   std::size_t bad_row = rows;
   std::int64_t batched = 0;
+  const bool terms_ready = body_terms_ready_ && ball_kin_.size() == n;
   ball_kin_.resize(n);
 #pragma omp parallel reduction(min : bad_row) reduction(+ : batched) if (n > kParallelMin)
   {
     // What the pair loop reads of each ball, in one record (two cache lines): one memory stream per
-    // neighbourhood instead of one per column. The hill terms from the current properties (real
-    // masses, §2.4).
+    // neighbourhood instead of one per column. The hill terms (four divisions per ball) only when the
+    // properties may have changed: at a rebuild, refresh_mappings() or a restore, the moments at which
+    // the row-by-row path's mappings are computed too (real masses, §2.4).
 #pragma omp for schedule(static)
-    for (std::size_t i = 0; i < n; ++i)
-      ball_kin_[i] = {balls.position[i], balls.radius[i], balls.velocity[i], balls.spin[i],
-                    hill_body_terms(balls.radius[i], balls.young_mod[i], balls.pois_ratio[i], balls.mass[i])};
+    for (std::size_t i = 0; i < n; ++i) {
+      BallKin& k = ball_kin_[i];
+      k.position = balls.position[i];
+      k.radius = balls.radius[i];
+      k.velocity = balls.velocity[i];
+      k.spin = balls.spin[i];
+      if (!terms_ready)
+        k.terms = hill_body_terms(balls.radius[i], balls.young_mod[i], balls.pois_ratio[i], balls.mass[i]);
+    }
     auto scratch = std::make_unique<BlockScratch>();  // ≈ 60 kB: on the heap, not the thread's stack
 #pragma omp for schedule(static)
     for (std::size_t k = 0; k < blocks; ++k)
       force_block(k * kBlock, std::min(n, (k + 1) * kBlock), dt, *scratch, bad_row, batched);
   }
   batched_rows_ = batched;
+  body_terms_ready_ = true;
   const std::size_t wall_rows = wall_rows_.size();
 #pragma omp parallel for schedule(static) reduction(min : bad_row) if (wall_rows > kParallelMin)
   for (std::size_t k = 0; k < wall_rows; ++k) {

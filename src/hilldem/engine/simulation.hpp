@@ -124,6 +124,7 @@ class Simulation {
   // bodies by hand.
   void invalidate_forces() {
     forces_ready_ = false;
+    body_terms_ready_ = false;
     rebuild_needed_ = true;
   }
   // Detect contacts and compute forces at the current state with no motion (Δt = 0 increments).
@@ -225,6 +226,7 @@ class Simulation {
     HillBodyTerms terms;   // for the hill mappings
   };
   std::vector<BallKin> ball_kin_;            // per ball, what the batched pair loop reads
+  bool body_terms_ready_ = false;            // ball_kin_[i].terms are up to date (see force_pass)
   std::vector<double> scaled_mass_, scaled_inertia_;  // density scaling [kg], [kg m²]
 };
 
