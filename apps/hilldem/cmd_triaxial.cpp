@@ -50,6 +50,7 @@ struct Options {
   bool pack_only = false;
   bool grading_given = false;  // --grading on the command line
   int threads = 1;
+  int jobs = 0;  // 0: the number of cores
   bool quiet = false;
 };
 
@@ -87,6 +88,7 @@ std::pair<StudySettings, std::vector<CaseSpec>> build(const Options& o) {
   s.suction = o.suction;
   s.moisture_gap = o.moisture_gap;
   s.specimen_file = o.specimen;
+  s.jobs = o.jobs;  // validated with the rest
   std::vector<CaseSpec> cases;
   if (o.study) {
     if (o.wet) throw InputError("--wet and --study: the study already has its wet case");
@@ -136,15 +138,7 @@ int run(const Options& o) {
   if (o.pack_only) {
     const auto t0 = std::chrono::steady_clock::now();
     const std::clock_t c0 = std::clock();
-    std::vector<PackedResult> packed;
-    std::vector<std::string> done;
-    for (const CaseSpec& c : cases) {
-      const std::string name = resolve_grading(c.grading).name;
-      if (std::find(done.begin(), done.end(), name) != done.end()) continue;
-      done.push_back(name);
-      if (log) *log << fmt::format("\n=== packing {} ===\n", name);
-      packed.push_back(make_packed(settings, c.grading, true, log));
-    }
+    const std::vector<PackedResult> packed = make_all_packed(settings, cases, true, log);
     std::cout << "\n" << packing_table(packed);
     std::cout << fmt::format("\nspecimens: {}/specimens/; {:.0f} s wall, {:.0f} s CPU\n", settings.output_dir,
                              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
@@ -208,7 +202,11 @@ Command add_triaxial_command(CLI::App& app) {
                 "genesis only: pack the specimen(s) and save them to <output>/specimens/ for later --specimen runs");
   cmd->add_flag("--no-plot", o->no_plot, "do not run scripts/plot_triaxial.py");
   cmd->add_option("--threads", o->threads,
-                  "OpenMP threads (default 1: lab specimens are small and gain little; 0: OpenMP's default)")
+                  "OpenMP threads per case (default 1: lab specimens are small and gain little; 0: OpenMP's default)")
+      ->check(CLI::Range(0, 1024));
+  cmd->add_option("--jobs", o->jobs,
+                  "cases (and packings) run at once, each on its own thread (default 0: the number of cores); "
+                  "results do not depend on it")
       ->check(CLI::Range(0, 1024));
   cmd->add_flag("-q,--quiet", o->quiet, "only the summary");
   return {cmd, [o, grading] {

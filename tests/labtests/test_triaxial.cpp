@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <sstream>
 #include <numbers>
 
 #include "hilldem/core/error.hpp"
@@ -313,6 +314,68 @@ TEST(Study, TwoCasesFromASavedSpecimenWriteTheirFilesAndSummary) {
   EXPECT_NE(md.find("M_r c1 [MPa]"), std::string::npos);
   EXPECT_TRUE(r.findings().empty());  // no C5n/C5b cases here
   std::filesystem::remove_all(dir);
+}
+
+// Cases run at once (--jobs) give the same bits as one after the other: each case is computed alone.
+TEST(Study, CasesRunAtOnceGiveTheSameResultsAsOneAfterTheOther) {
+  const auto dir = std::filesystem::temp_directory_path() / "hilldem_labtests_study_jobs";
+  std::filesystem::remove_all(dir);
+  const std::string file = (dir / "mini_packed.csv").string();
+  save_packed_specimen(testing::mini_packed(), testing::mini_spec().packing, file);
+  StudySettings st;
+  st.genesis = testing::mini_spec();
+  st.specimen_file = file;
+  st.triaxial = mini_test();
+  st.triaxial.cycle_strains = {2e-4};
+  st.triaxial.final_strain = 4e-4;
+  const std::string grading = std::string(HILLDEM_SOURCE_DIR) + "/tests/data/labtests/fine.csv";
+  const std::vector<CaseSpec> cases{{grading, GrainModel::Linear, false}, {grading, GrainModel::Hill, false},
+                                    {grading, GrainModel::Hill, true}};
+  auto run = [&](int jobs, std::ostringstream& log) {
+    st.jobs = jobs;
+    st.output_dir = (dir / ("jobs" + std::to_string(jobs))).string();
+    return run_study(st, cases, &log);
+  };
+  std::ostringstream log1, log3;
+  const StudyResult one = run(1, log1);
+  const StudyResult three = run(3, log3);
+  ASSERT_EQ(three.cases.size(), cases.size());
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    EXPECT_EQ(three.cases[k].spec.name(), cases[k].name());  // case order kept
+    EXPECT_EQ(three.cases[k].test.history_csv(), one.cases[k].test.history_csv()) << cases[k].name();
+  }
+  // The summary too, but for its last column (the wall-clock seconds of each case).
+  auto without_seconds = [](const std::string& csv) {
+    std::istringstream in(csv);
+    std::string out;
+    for (std::string line; std::getline(in, line);) out += line.substr(0, line.rfind(',')) + "\n";
+    return out;
+  };
+  EXPECT_EQ(without_seconds(three.summary_csv()), without_seconds(one.summary_csv()));
+  // With several jobs every log line names its case, and no line is cut by another case's output.
+  std::istringstream lines(log3.str());
+  std::size_t count = 0;
+  for (std::string line; std::getline(lines, line); ++count) {
+    const bool named = line.rfind("[fine_Linear] ", 0) == 0 || line.rfind("[fine_Hill] ", 0) == 0 ||
+                       line.rfind("[fine_Hill_wet] ", 0) == 0 || line.rfind("[specimen fine] ", 0) == 0;
+    EXPECT_TRUE(named) << line;
+  }
+  EXPECT_GT(count, 10u);
+  EXPECT_EQ(log1.str().find("[fine_Hill]"), std::string::npos);  // one job: the log as before
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Study, BadJobsCountIsRefused) {
+  StudySettings st;
+  st.genesis = testing::mini_spec();
+  st.jobs = -1;
+  const std::string grading = std::string(HILLDEM_SOURCE_DIR) + "/tests/data/labtests/fine.csv";
+  try {
+    validate(st, {{grading, GrainModel::Hill, false}});
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("--jobs"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Study, FindingsAreComputedFromTheNumbers) {

@@ -35,6 +35,10 @@ struct StudySettings {
   std::string output_dir = "out/triaxial";
   std::string specimen_file;            // start from this packed specimen instead of packing
   bool save_specimens = true;           // write <output>/specimens/<grading>_packed.csv
+  // Cases (and packings) computed at once, each on its own thread with its own Simulation: every case
+  // is computed alone from the same inputs, so the results do not depend on it. 0: the number of
+  // cores. With more than one, each log line is prefixed with its case's name.
+  int jobs = 1;
 };
 // Every check that can be made before work starts (throws InputError): settings ranges, gradings
 // resolvable, wet only with hill, the specimen file readable.
@@ -62,7 +66,9 @@ struct StudyResult {
   std::vector<std::string> findings() const;  // the memo's qualitative claims, each with numbers and a verdict
 };
 
-// Runs the cases, writing into settings.output_dir as it goes; progress to log (may be null).
+// Runs the cases (settings.jobs at once), writing into settings.output_dir as each one ends; progress
+// to log (may be null). If a case fails, no new case starts and the error of the first failing case
+// (in case order) is thrown once the running ones end.
 StudyResult run_study(const StudySettings& settings, const std::vector<CaseSpec>& cases, std::ostream* log);
 
 // Genesis up to the packed specimen (cloud, frictionless packing) for one grading, or the specimen
@@ -76,6 +82,10 @@ struct PackedResult {
   double seconds = 0.0;
 };
 PackedResult make_packed(const StudySettings& settings, const std::string& grading, bool save, std::ostream* log);
+// make_packed for each distinct grading of the cases (by resolved name, in case order), settings.jobs
+// at once.
+std::vector<PackedResult> make_all_packed(const StudySettings& settings, const std::vector<CaseSpec>& cases, bool save,
+                                          std::ostream* log);
 // One line per packed specimen: grading, seed, grains, porosities, coordination, pressures, steps, time.
 std::string packing_table(const std::vector<PackedResult>& packed);
 
