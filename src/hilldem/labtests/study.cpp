@@ -374,11 +374,12 @@ int resolved_jobs(int jobs, std::size_t work) {
   return static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(n), std::max<std::size_t>(work, 1)));
 }
 
-// Runs task(i, log) for i in [0, count) on `jobs` threads (in the calling thread when jobs is 1), taking
-// the items in the given order (all of 0..count-1; empty: in index order). With
-// `prefix` each item's log lines are prefixed with names[i]; else the log is passed as given. Each worker gets the caller's OpenMP thread count (a new thread would otherwise
-// start from OpenMP's default). After a failure no new item starts; the first failure by index is
-// rethrown once the running items end.
+// Runs task(i, log) for i in [0, count) on `jobs` threads, taking the items in the given order (a
+// permutation of 0..count-1; empty: index order), or one after the other in index order in the
+// calling thread when jobs is 1. With `prefix` each item's log lines are prefixed with names[i];
+// else the log is passed as given. Each worker gets the caller's OpenMP thread count (a new thread
+// would otherwise start from OpenMP's default). After a failure no new item starts; the first
+// failure by index is rethrown once the running items end.
 template <class Task>
 void for_each_job(std::size_t count, int jobs, bool prefix, const std::vector<std::string>& names, std::ostream* log,
                   std::vector<std::size_t> order, Task&& task) {
