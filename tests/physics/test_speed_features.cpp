@@ -8,6 +8,7 @@
 
 #include "hilldem/contact/cell_grid.hpp"
 #include "hilldem/core/error.hpp"
+#include "hilldem/engine/thread_budget.hpp"
 #include "hilldem/io/packing_import.hpp"
 #include "sim_builders.hpp"
 
@@ -168,6 +169,36 @@ TEST(Threads, OneAndTwoThreadsGiveBitwiseIdenticalResults) {
   ASSERT_EQ(one.first.size(), two.first.size());
   std::size_t differ = 0;
   for (std::size_t i = 0; i < one.first.size(); ++i) differ += !(one.first[i] == two.first[i]) || !(one.second[i] == two.second[i]);
+  EXPECT_EQ(differ, 0u);
+}
+
+// A thread count that changes from step to step (engine/thread_budget.hpp, as a study's cases share
+// the cores) gives the same bits as one thread throughout.
+TEST(ThreadBudget, ACountThatChangesWhileItRunsGivesTheSameResults) {
+  struct Alternating : ThreadBudget {
+    mutable int calls = 0;
+    int threads() const override { return 1 + (calls++ / 7) % 2; }  // 7 steps on 1 thread, 7 on 2, ...
+  };
+  auto run = [](const ThreadBudget* budget) {
+    omp_set_num_threads(1);
+    set_thread_budget(budget);
+    Simulation sim = random_box(4000, 9, true, 0.1);  // above the parallel threshold
+    sim.settings.gravity = {0, 0, -9.81};
+    sim.settings.local_damping = 0.3;
+    sim.settings.auto_timestep = true;
+    sim.make_wet(20e3, 0.5e-3);
+    sim.cycle(100);
+    set_thread_budget(nullptr);
+    return std::make_pair(sim.balls.position, sim.balls.spin);
+  };
+  const Alternating alternating;
+  const auto one = run(nullptr), changing = run(&alternating);
+  EXPECT_GE(alternating.calls, 100);  // asked before every step
+  omp_set_num_threads(omp_get_num_procs());
+  ASSERT_EQ(one.first.size(), changing.first.size());
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < one.first.size(); ++i)
+    differ += !(one.first[i] == changing.first[i]) || !(one.second[i] == changing.second[i]);
   EXPECT_EQ(differ, 0u);
 }
 

@@ -10,6 +10,7 @@
 #include "hilldem/contact/cell_grid.hpp"
 #include "hilldem/core/error.hpp"
 #include "hilldem/engine/contact_batch.hpp"
+#include "hilldem/engine/thread_budget.hpp"
 
 namespace hilldem {
 
@@ -47,6 +48,7 @@ double Simulation::skin() const {
 }
 
 void Simulation::step_once() {
+  apply_thread_budget();  // when several simulations share the cores (engine/thread_budget.hpp)
   if (!forces_ready_) update_forces();
   const double dt = next_timestep();
   for (const auto& control : controllers) control(*this, dt);  // servos set wall velocities

@@ -20,6 +20,7 @@
 #endif
 
 #include "hilldem/core/error.hpp"
+#include "hilldem/engine/thread_budget.hpp"
 #include "hilldem/labtests/specimen_io.hpp"
 
 namespace hilldem {
@@ -369,6 +370,19 @@ class PrefixedLog : public std::streambuf {
   std::string line_;
 };
 
+// The cores shared by the items running at once: each gets cores / running threads (at least the
+// caller's OpenMP thread count, the --threads of the CLI), so that when fewer items than cores are left
+// the ones still running take the idle cores. Read by each simulation before every step.
+class SharedCores : public ThreadBudget {
+ public:
+  SharedCores(int cores, int min_threads) : cores_(std::max(1, cores)), min_threads_(std::max(1, min_threads)) {}
+  int threads() const override { return std::max(min_threads_, cores_ / std::max(1, running.load())); }
+  std::atomic<int> running{0};
+
+ private:
+  int cores_, min_threads_;
+};
+
 int resolved_jobs(int jobs, std::size_t work) {
   int n = jobs > 0 ? jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   return static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(n), std::max<std::size_t>(work, 1)));
@@ -377,9 +391,10 @@ int resolved_jobs(int jobs, std::size_t work) {
 // Runs task(i, log) for i in [0, count) on `jobs` threads, taking the items in the given order (a
 // permutation of 0..count-1; empty: index order), or one after the other in index order in the
 // calling thread when jobs is 1. With `prefix` each item's log lines are prefixed with names[i];
-// else the log is passed as given. Each worker gets the caller's OpenMP thread count (a new thread
-// would otherwise start from OpenMP's default). After a failure no new item starts; the first
-// failure by index is rethrown once the running items end.
+// else the log is passed as given. With several jobs the cores are shared (SharedCores): each item
+// runs with at least the caller's OpenMP thread count, more when fewer items than cores are left.
+// After a failure no new item starts; the first failure by index is rethrown once the running items
+// end.
 template <class Task>
 void for_each_job(std::size_t count, int jobs, bool prefix, const std::vector<std::string>& names, std::ostream* log,
                   std::vector<std::size_t> order, Task&& task) {
@@ -397,24 +412,27 @@ void for_each_job(std::size_t count, int jobs, bool prefix, const std::vector<st
     return;
   }
 #ifdef _OPENMP
-  const int omp_threads = omp_get_max_threads();
+  SharedCores cores(omp_get_num_procs(), omp_get_max_threads());
+#else
+  SharedCores cores(1, 1);
 #endif
   std::atomic<std::size_t> next{0};
   std::atomic<bool> failed{false};
   std::vector<std::exception_ptr> errors(count);
   auto worker = [&] {
-#ifdef _OPENMP
-    omp_set_num_threads(omp_threads);
-#endif
+    set_thread_budget(&cores);
     for (std::size_t k; !failed && (k = next++) < count;) {
       const std::size_t i = order[k];
+      ++cores.running;
       try {
         run_one(i);
       } catch (...) {
         errors[i] = std::current_exception();
         failed = true;
       }
+      --cores.running;
     }
+    set_thread_budget(nullptr);
   };
   std::vector<std::thread> threads;
   for (int k = 0; k < jobs; ++k) threads.emplace_back(worker);
