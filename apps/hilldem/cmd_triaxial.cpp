@@ -206,7 +206,7 @@ Command add_triaxial_command(CLI::App& app) {
       ->check(CLI::Range(0, 1024));
   cmd->add_option("--jobs", o->jobs,
                   "cases (and packings) run at once, each on its own thread (default 0: the number of cores); "
-                  "results do not depend on it")
+                  "when fewer are left than cores, the ones running take the idle cores; results do not depend on it")
       ->check(CLI::Range(0, 1024));
   cmd->add_flag("-q,--quiet", o->quiet, "only the summary");
   return {cmd, [o, grading] {
