@@ -421,13 +421,11 @@ HILLDEM_INLINE Simulation::RowShare Simulation::store_row(std::size_t c, const R
   // Only the columns the cycle needs (memory traffic): F_s = F_c − (F_n + F^m) n̂ is derived.
   contacts.shear_state[c] = out.shear;
   contacts.normal[c] = out.normal;
-  contacts.force[c] = out.force;
-#ifndef EXP_NOREPORT
   contacts.gap[c] = out.gap;
+  contacts.force[c] = out.force;
   contacts.normal_force[c] = out.normal_force;
   contacts.moisture_force[c] = out.moisture_force;
   contacts.trial_shear[c] = out.trial_shear;
-#endif
   if (want_stiffness) {  // only the time-step estimate and density scaling read them
     contacts.k_tran[c] = out.k_tran;
     contacts.k_shear[c] = out.k_shear;
@@ -537,11 +535,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, double dt, BlockScr
         batch.col(F::kCn1)[lane] = ka.terms.normal, batch.col(F::kCs1)[lane] = ka.terms.shear;
         batch.col(F::kIr2)[lane] = kb.terms.inv_radius, batch.col(F::kIm2)[lane] = kb.terms.inv_mass;
         batch.col(F::kCn2)[lane] = kb.terms.normal, batch.col(F::kCs2)[lane] = kb.terms.shear;
-#ifdef EXP_NOPARAMS
-        const HillParams& p = table.rules[0].hill;
-#else
         const HillParams& p = contacts.hill_params[c];
-#endif
         batch.col(F::kFric)[lane] = p.fric_coef, batch.col(F::kSuction)[lane] = p.suction;
         batch.col(F::kDamp)[lane] = p.damp_con;
         batch.col(F::kWet)[lane] = contacts.moisture[c] == Moisture::Wet ? 1.0 : 0.0;

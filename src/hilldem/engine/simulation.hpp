@@ -110,7 +110,9 @@ class Simulation {
   // Rows that went through the batched law in the last force pass.
   std::int64_t batched_rows() const { return batched_rows_; }
 
-  // Recompute every contact's mapping (after properties of bodies or contacts changed).
+  // Recompute every contact's mapping, and the per-ball terms the batched hill law builds its
+  // mappings from, after properties of bodies or contacts changed (radius, density, E, ν: the
+  // cycle does not watch them).
   void refresh_mappings();
   // Rebuild the neighbour list before the next force evaluation (after bodies were added or moved
   // by hand, or the table changed).
