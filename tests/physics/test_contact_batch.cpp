@@ -58,6 +58,30 @@ TEST(HillBatch, SameMotionAsTheRowByRowLawWetAndDry) {
   EXPECT_LT(worst_position_gap(batch, rows), 1e-12);  // radii 2-3 mm: rounding only
 }
 
+// Properties changed in the middle of a run, then refresh_mappings(): the batched law takes the new
+// E and ν from the same moment as the row-by-row law (its per-ball terms are cached between passes).
+TEST(HillBatch, PropertiesChangedAndRefreshedMidRun) {
+  auto run = [](bool batched) {
+    Simulation sim = random_box(600, 21);
+    sim.use_batched_kernel = batched;
+    sim.settings.gravity = {0, 0, -9.81};
+    sim.settings.auto_timestep = true;
+    sim.make_wet(20e3, 0.5e-3);
+    sim.cycle(150);
+    for (std::size_t i = 0; i < sim.balls.size(); ++i) {
+      sim.balls.young_mod[i] *= i % 2 ? 0.25 : 3.0;  // [Pa] much softer and much stiffer grains
+      sim.balls.pois_ratio[i] = 0.3;
+    }
+    sim.refresh_mappings();
+    sim.cycle(150);
+    return outcome(sim);
+  };
+  const Outcome batch = run(true), rows = run(false);
+  EXPECT_GT(batch.batched, 100);
+  EXPECT_EQ(batch.contacts, rows.contacts);
+  EXPECT_LT(worst_position_gap(batch, rows), 1e-12);
+}
+
 // A periodic box (x, y, z; no walls) of 400 fast wet grains, shifted so that the boundaries cut the
 // cloud: contacts across the boundaries (periodic images in the gather) and positions wrapped at
 // rebuilds; the same motion either way.
