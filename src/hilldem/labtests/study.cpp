@@ -391,13 +391,14 @@ int resolved_jobs(int jobs, std::size_t work) {
 // Runs task(i, log) for i in [0, count) on `jobs` threads, taking the items in the given order (a
 // permutation of 0..count-1; empty: index order), or one after the other in index order in the
 // calling thread when jobs is 1. With `prefix` each item's log lines are prefixed with names[i];
-// else the log is passed as given. With several jobs the cores are shared (SharedCores): each item
-// runs with at least the caller's OpenMP thread count, more when fewer items than cores are left.
+// else the log is passed as given. With several jobs, or with share_cores, the cores are shared
+// (SharedCores): each item runs with at least the caller's OpenMP thread count, more when fewer items
+// than cores are left (a single job takes them all).
 // After a failure no new item starts; the first failure by index is rethrown once the running items
 // end.
 template <class Task>
-void for_each_job(std::size_t count, int jobs, bool prefix, const std::vector<std::string>& names, std::ostream* log,
-                  std::vector<std::size_t> order, Task&& task) {
+void for_each_job(std::size_t count, int jobs, bool share_cores, bool prefix, const std::vector<std::string>& names,
+                  std::ostream* log, std::vector<std::size_t> order, Task&& task) {
   if (order.empty())
     for (std::size_t i = 0; i < count; ++i) order.push_back(i);
   std::mutex log_mutex;
@@ -407,15 +408,32 @@ void for_each_job(std::size_t count, int jobs, bool prefix, const std::vector<st
     std::ostream line_log(&buffer);
     task(i, &line_log);
   };
-  if (jobs <= 1 || count <= 1) {
-    for (std::size_t i = 0; i < count; ++i) run_one(i);  // one at a time: in index order
-    return;
-  }
 #ifdef _OPENMP
   SharedCores cores(omp_get_num_procs(), omp_get_max_threads());
 #else
   SharedCores cores(1, 1);
 #endif
+  // The calling thread's budget and OpenMP thread count back as they were, however this ends.
+  struct BudgetGuard {
+    const ThreadBudget* before = thread_budget();
+#ifdef _OPENMP
+    int threads = omp_get_max_threads();
+    ~BudgetGuard() {
+      set_thread_budget(before);
+      omp_set_num_threads(threads);
+    }
+#else
+    ~BudgetGuard() { set_thread_budget(before); }
+#endif
+  } guard;
+  if (jobs <= 1 || count <= 1) {
+    if (share_cores) {  // one job: it takes every core
+      cores.running = 1;
+      set_thread_budget(&cores);
+    }
+    for (std::size_t i = 0; i < count; ++i) run_one(i);  // one at a time: in index order
+    return;
+  }
   std::atomic<std::size_t> next{0};
   std::atomic<bool> failed{false};
   std::vector<std::exception_ptr> errors(count);
@@ -462,7 +480,7 @@ std::vector<PackedResult> make_all_packed(const StudySettings& settings, const s
   for (const auto& g : gradings) labels.push_back((loaded ? "specimen " : "packing ") + g.second);
   // Prefixed log lines whenever the study runs more than one job, so that its whole log reads alike.
   const bool prefix = resolved_jobs(settings.jobs, cases.size()) > 1;
-  for_each_job(gradings.size(), resolved_jobs(settings.jobs, gradings.size()), prefix, labels, log, {},
+  for_each_job(gradings.size(), resolved_jobs(settings.jobs, gradings.size()), settings.jobs != 1, prefix, labels, log, {},
                [&](std::size_t i, std::ostream* out) {
                  if (out) *out << fmt::format("\n=== {} ===\n", labels[i]) << std::flush;
                  packed[i] = make_packed(settings, gradings[i].first, save, out);
@@ -502,7 +520,7 @@ StudyResult run_study(const StudySettings& settings, const std::vector<CaseSpec>
               (cases[i].model == GrainModel::Hill ? 1.5 : 1.0) * (cases[i].wet ? 1.5 : 1.0);
   }
   std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return cost[x] > cost[y]; });
-  for_each_job(cases.size(), jobs, jobs > 1, names, log, order, [&](std::size_t i, std::ostream* clog) {
+  for_each_job(cases.size(), jobs, settings.jobs != 1, jobs > 1, names, log, order, [&](std::size_t i, std::ostream* clog) {
     const CaseSpec& c = cases[i];
     const PackedResult& p = packed_for(c);
     if (clog) *clog << fmt::format("\n=== {} ===\n", c.name()) << std::flush;

@@ -37,7 +37,9 @@ struct StudySettings {
   bool save_specimens = true;           // write <output>/specimens/<grading>_packed.csv
   // Cases (and packings) computed at once, each on its own thread with its own Simulation: every case
   // is computed alone from the same inputs, so the results do not depend on it. 0: the number of
-  // cores. With more than one, each log line is prefixed with its case's name.
+  // cores. With more than one, each log line is prefixed with its case's name. Unless 1, the cores
+  // are shared: a job runs on cores / running jobs OpenMP threads (at least the caller's count), so
+  // that when fewer jobs than cores are left the running ones take the idle cores.
   int jobs = 1;
 };
 // Every check that can be made before work starts (throws InputError): settings ranges, gradings
