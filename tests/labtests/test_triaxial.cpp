@@ -284,8 +284,9 @@ TEST(SpecimenFile, SavedPackedSpecimenReloadsToTheSameState) {
 // ---------------------------------------------------------------------------------------------------
 // The study driver on the miniature specimen: files, summary, findings.
 
-TEST(Study, TwoCasesFromASavedSpecimenWriteTheirFilesAndSummary) {
-  const auto dir = std::filesystem::temp_directory_path() / "hilldem_labtests_study";
+// A study of the miniature specimen, saved into a fresh folder `dir`: one cycle at 0.02 %, then on to
+// final_strain [-].
+StudySettings mini_study(const std::filesystem::path& dir, double final_strain) {
   std::filesystem::remove_all(dir);
   const std::string file = (dir / "mini_packed.csv").string();
   save_packed_specimen(testing::mini_packed(), testing::mini_spec().packing, file);
@@ -295,7 +296,13 @@ TEST(Study, TwoCasesFromASavedSpecimenWriteTheirFilesAndSummary) {
   st.output_dir = (dir / "out").string();
   st.triaxial = mini_test();
   st.triaxial.cycle_strains = {2e-4};
-  st.triaxial.final_strain = 5e-4;
+  st.triaxial.final_strain = final_strain;
+  return st;
+}
+
+TEST(Study, TwoCasesFromASavedSpecimenWriteTheirFilesAndSummary) {
+  const auto dir = std::filesystem::temp_directory_path() / "hilldem_labtests_study";
+  const StudySettings st = mini_study(dir, 5e-4);
   const std::string grading = std::string(HILLDEM_SOURCE_DIR) + "/tests/data/labtests/fine.csv";
   const StudyResult r = run_study(st, {{grading, GrainModel::Linear, false}, {grading, GrainModel::Hill, false}}, nullptr);
   ASSERT_EQ(r.cases.size(), 2u);
@@ -319,15 +326,7 @@ TEST(Study, TwoCasesFromASavedSpecimenWriteTheirFilesAndSummary) {
 // Cases run at once (--jobs) give the same bits as one after the other: each case is computed alone.
 TEST(Study, CasesRunAtOnceGiveTheSameResultsAsOneAfterTheOther) {
   const auto dir = std::filesystem::temp_directory_path() / "hilldem_labtests_study_jobs";
-  std::filesystem::remove_all(dir);
-  const std::string file = (dir / "mini_packed.csv").string();
-  save_packed_specimen(testing::mini_packed(), testing::mini_spec().packing, file);
-  StudySettings st;
-  st.genesis = testing::mini_spec();
-  st.specimen_file = file;
-  st.triaxial = mini_test();
-  st.triaxial.cycle_strains = {2e-4};
-  st.triaxial.final_strain = 4e-4;
+  StudySettings st = mini_study(dir, 4e-4);
   const std::string grading = std::string(HILLDEM_SOURCE_DIR) + "/tests/data/labtests/fine.csv";
   const std::vector<CaseSpec> cases{{grading, GrainModel::Linear, false}, {grading, GrainModel::Hill, false},
                                     {grading, GrainModel::Hill, true}};

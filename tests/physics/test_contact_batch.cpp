@@ -38,13 +38,18 @@ double worst_position_gap(const Outcome& x, const Outcome& y) {
 // A box of 600 grains thrown about (0.5 m/s, 50 rad/s), wetted within 0.5 mm (suction 20 kPa), under
 // gravity with the automatic time step (Eqs. 19-21 through the batch): contacts form, slip, separate
 // and their bridges rupture.
+Simulation wet_box(bool batched) {
+  Simulation sim = random_box(600, 21);
+  sim.use_batched_kernel = batched;
+  sim.settings.gravity = {0, 0, -9.81};
+  sim.settings.auto_timestep = true;
+  sim.make_wet(20e3, 0.5e-3);
+  return sim;
+}
+
 TEST(HillBatch, SameMotionAsTheRowByRowLawWetAndDry) {
   auto run = [](bool batched) {
-    Simulation sim = random_box(600, 21);
-    sim.use_batched_kernel = batched;
-    sim.settings.gravity = {0, 0, -9.81};
-    sim.settings.auto_timestep = true;
-    sim.make_wet(20e3, 0.5e-3);
+    Simulation sim = wet_box(batched);
     sim.cycle(300);
     return outcome(sim);
   };
@@ -62,11 +67,7 @@ TEST(HillBatch, SameMotionAsTheRowByRowLawWetAndDry) {
 // E and ν from the same moment as the row-by-row law (its per-ball terms are cached between passes).
 TEST(HillBatch, PropertiesChangedAndRefreshedMidRun) {
   auto run = [](bool batched) {
-    Simulation sim = random_box(600, 21);
-    sim.use_batched_kernel = batched;
-    sim.settings.gravity = {0, 0, -9.81};
-    sim.settings.auto_timestep = true;
-    sim.make_wet(20e3, 0.5e-3);
+    Simulation sim = wet_box(batched);
     sim.cycle(150);
     for (std::size_t i = 0; i < sim.balls.size(); ++i) {
       sim.balls.young_mod[i] *= i % 2 ? 0.25 : 3.0;  // [Pa] much softer and much stiffer grains

@@ -152,24 +152,37 @@ TEST(PackingImport, XyzrAndErrors) {
   EXPECT_THROW(replicate(p, n), InputError);  // no box
 }
 
+// 4,000 wet grains settling under gravity with local damping and the automatic time step: above the
+// threshold below which the passes stay on one thread.
+Simulation wet_box_4000() {
+  Simulation sim = random_box(4000, 9, true, 0.1);
+  sim.settings.gravity = {0, 0, -9.81};
+  sim.settings.local_damping = 0.3;
+  sim.settings.auto_timestep = true;
+  sim.make_wet(20e3, 0.5e-3);
+  return sim;
+}
+
+// Balls whose position or spin differ in any bit between two runs.
+std::size_t differing_balls(const std::pair<std::vector<Vec3>, std::vector<Vec3>>& x,
+                            const std::pair<std::vector<Vec3>, std::vector<Vec3>>& y) {
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < x.first.size(); ++i) differ += !(x.first[i] == y.first[i]) || !(x.second[i] == y.second[i]);
+  return differ;
+}
+
 // Bitwise identical positions after N steps for 1 and 2 threads (issue #4 acceptance).
 TEST(Threads, OneAndTwoThreadsGiveBitwiseIdenticalResults) {
   auto run = [](int threads) {
     omp_set_num_threads(threads);
-    Simulation sim = random_box(4000, 9, true, 0.1);  // above the parallel threshold
-    sim.settings.gravity = {0, 0, -9.81};
-    sim.settings.local_damping = 0.3;
-    sim.settings.auto_timestep = true;
-    sim.make_wet(20e3, 0.5e-3);
+    Simulation sim = wet_box_4000();
     sim.cycle(150);
     return std::make_pair(sim.balls.position, sim.balls.spin);
   };
   const auto one = run(1), two = run(2);
   omp_set_num_threads(omp_get_num_procs());
   ASSERT_EQ(one.first.size(), two.first.size());
-  std::size_t differ = 0;
-  for (std::size_t i = 0; i < one.first.size(); ++i) differ += !(one.first[i] == two.first[i]) || !(one.second[i] == two.second[i]);
-  EXPECT_EQ(differ, 0u);
+  EXPECT_EQ(differing_balls(one, two), 0u);
 }
 
 // A thread count that changes from step to step (engine/thread_budget.hpp, as a study's cases share
@@ -182,11 +195,7 @@ TEST(ThreadBudget, ACountThatChangesWhileItRunsGivesTheSameResults) {
   auto run = [](const ThreadBudget* budget) {
     omp_set_num_threads(1);
     set_thread_budget(budget);
-    Simulation sim = random_box(4000, 9, true, 0.1);  // above the parallel threshold
-    sim.settings.gravity = {0, 0, -9.81};
-    sim.settings.local_damping = 0.3;
-    sim.settings.auto_timestep = true;
-    sim.make_wet(20e3, 0.5e-3);
+    Simulation sim = wet_box_4000();
     sim.cycle(100);
     set_thread_budget(nullptr);
     return std::make_pair(sim.balls.position, sim.balls.spin);
@@ -196,10 +205,7 @@ TEST(ThreadBudget, ACountThatChangesWhileItRunsGivesTheSameResults) {
   EXPECT_GE(alternating.calls, 100);  // asked before every step
   omp_set_num_threads(omp_get_num_procs());
   ASSERT_EQ(one.first.size(), changing.first.size());
-  std::size_t differ = 0;
-  for (std::size_t i = 0; i < one.first.size(); ++i)
-    differ += !(one.first[i] == changing.first[i]) || !(one.second[i] == changing.second[i]);
-  EXPECT_EQ(differ, 0u);
+  EXPECT_EQ(differing_balls(one, changing), 0u);
 }
 
 // The skin is an optimisation only: a run with a large skin (few rebuilds) equals one that
