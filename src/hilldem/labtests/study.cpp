@@ -496,13 +496,15 @@ StudyResult run_study(const StudySettings& settings, const std::vector<CaseSpec>
   fs::create_directories(out);
   // One packing per grading, all before the first case (at once when jobs allow).
   const std::vector<PackedResult> all_packed = make_all_packed(settings, cases, settings.save_specimens, log);
+  // Each case's packing, looked up once (resolving a grading may read its file), before any job starts.
   const auto gradings = distinct_gradings(cases);
-  auto packed_for = [&](const CaseSpec& c) -> const PackedResult& {
-    const std::string name = resolve_grading(c.grading).name;
+  std::vector<const PackedResult*> packed_of(cases.size());
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    const std::string name = resolve_grading(cases[i].grading).name;
     std::size_t k = 0;
     while (gradings[k].second != name) ++k;
-    return all_packed[k];
-  };
+    packed_of[i] = &all_packed[k];
+  }
   std::vector<std::optional<CaseResult>> done(cases.size());
   std::mutex done_mutex;
   StudyResult study;
@@ -516,13 +518,13 @@ StudyResult run_study(const StudySettings& settings, const std::vector<CaseSpec>
   std::vector<double> cost(cases.size());
   for (std::size_t i = 0; i < cases.size(); ++i) {
     order[i] = i;
-    cost[i] = static_cast<double>(packed_for(cases[i]).specimen.sim.balls.size()) *
+    cost[i] = static_cast<double>(packed_of[i]->specimen.sim.balls.size()) *
               (cases[i].model == GrainModel::Hill ? 1.5 : 1.0) * (cases[i].wet ? 1.5 : 1.0);
   }
   std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return cost[x] > cost[y]; });
   for_each_job(cases.size(), jobs, settings.jobs != 1, jobs > 1, names, log, order, [&](std::size_t i, std::ostream* clog) {
     const CaseSpec& c = cases[i];
-    const PackedResult& p = packed_for(c);
+    const PackedResult& p = *packed_of[i];
     if (clog) *clog << fmt::format("\n=== {} ===\n", c.name()) << std::flush;
     const auto tc = std::chrono::steady_clock::now();
     CaseResult r;
