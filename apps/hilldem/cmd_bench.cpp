@@ -18,6 +18,8 @@ Command add_bench_command(CLI::App& app) {
   bench->add_option("--steps", o->steps, "timed steps")->check(CLI::Range(1, 100000000));
   bench->add_option("--warmup", o->warmup, "untimed steps first")->check(CLI::Range(0, 100000000));
   bench->add_option("--threads", o->threads, "OpenMP threads (0: default)")->check(CLI::Range(0, 1024));
+  bench->add_option("--block", o->block, "balls per block of the force pass (0: the default, 128); a tuning knob, "
+                    "results do not depend on it")->check(CLI::Range(0, 1000000));
   bench->add_option("--settle", *settle_out,
                     "instead of timing: settle the --data bed under hilldem's laws and write it to this file");
   return {bench, [o, settle_out] {

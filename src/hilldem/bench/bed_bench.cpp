@@ -78,6 +78,7 @@ BedBenchResult run_bed_bench(const BedBenchOptions& o) {
   const int rep[3] = {o.replicate, o.replicate, 1};
   replicate(packing, rep);
   Simulation sim = make_bed(packing);
+  if (o.block > 0) sim.balls_per_block = o.block;
   sim.cycle(o.warmup);
   const std::int64_t rebuilds0 = sim.rebuilds();
   const auto start = std::chrono::steady_clock::now();

@@ -17,6 +17,7 @@ struct BedBenchOptions {
   std::int64_t warmup = 200;  // untimed steps
   std::int64_t steps = 1000;  // timed steps
   int threads = 0;            // 0 = OpenMP default
+  std::size_t block = 0;      // balls per block of the force pass (0: the engine's default); tuning only
 };
 
 struct BedBenchResult {

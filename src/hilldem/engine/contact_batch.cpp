@@ -24,9 +24,8 @@ Cols cols(ContactBatch& b, ContactBatch::Field first) {
 }
 
 // Geometry (Eqs. 2-3) of every lane; coincident centres keep the old normal.
-void batch_geometry(ContactBatch& batch) {
+void batch_geometry(ContactBatch& batch, std::size_t n) {
   using F = ContactBatch;
-  const std::size_t n = batch.size();
   const Cols d = cols(batch, F::kDx), n_old = cols(batch, F::kNox), n_new = cols(batch, F::kNx);
   const double* __restrict r1 = batch.col(F::kR1);
   const double* __restrict r2 = batch.col(F::kR2);
@@ -134,9 +133,18 @@ HILLDEM_INLINE void store_lane(const LaneOutputs& o, std::size_t i, bool active,
 
 }  // namespace
 
+std::size_t ContactBatch::pad_lanes() {
+  static_assert(kLanes % kVector == 0);
+  const std::size_t padded = (size_ + kVector - 1) / kVector * kVector;
+  if (size_ == 0) return 0;
+  for (int f = 0; f < kKn; ++f)  // the inputs
+    for (std::size_t lane = size_; lane < padded; ++lane) data_[f][lane] = data_[f][size_ - 1];
+  return padded;
+}
+
 void hill_batch_forces(ContactBatch& batch, double dt, bool want_stiffness) {
   using F = ContactBatch;
-  const std::size_t n = batch.size();
+  const std::size_t n = batch.pad_lanes();
   const Cols n_new = cols(batch, F::kNx);
   const double* __restrict r1 = batch.col(F::kR1);
   const double* __restrict r2 = batch.col(F::kR2);
@@ -173,7 +181,7 @@ void hill_batch_forces(ContactBatch& batch, double dt, bool want_stiffness) {
     }
   }
 
-  batch_geometry(batch);
+  batch_geometry(batch, n);
 
   // 2. Moisture (Eq. 12): the bridge force or its rupture, for wet lanes only (exp does not vectorise
   // without relaxing the math library's accuracy).
@@ -242,8 +250,8 @@ void hill_batch_forces(ContactBatch& batch, double dt, bool want_stiffness) {
 
 void linear_batch_forces(ContactBatch& batch, double dt, bool want_stiffness) {
   using F = ContactBatch;
-  const std::size_t n = batch.size();
-  batch_geometry(batch);
+  const std::size_t n = batch.pad_lanes();
+  batch_geometry(batch, n);
   const Cols n_new = cols(batch, F::kNx);
   const double* __restrict kn = batch.col(F::kIr1);
   const double* __restrict ks = batch.col(F::kIr2);

@@ -61,6 +61,13 @@ class ContactBatch {
     return size_++;
   }
   std::size_t size() const { return size_; }
+  // Lanes the laws compute: size() rounded up to a whole number of vectors (kVector), the extra
+  // lanes holding copies of the last lane's inputs. Every lane is then computed by the vectorised
+  // body of the law's loops, none by a scalar remainder loop (whose multiply-adds the compiler fuses
+  // differently), so a contact's result does not depend on how contacts fall into batches, and the
+  // block size of the force pass is a pure tuning knob. Their results are never read.
+  std::size_t pad_lanes();
+  static constexpr std::size_t kVector = 8;
   std::uint32_t row(std::size_t lane) const { return row_[lane]; }
   double* col(Field f) { return data_[f]; }
   const double* col(Field f) const { return data_[f]; }

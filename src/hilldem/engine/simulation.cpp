@@ -573,8 +573,8 @@ void Simulation::force_pass(double dt) {
   // Blocks of balls, each with its own rows (ball-ball rows are sorted by their first ball); each
   // row writes only its own columns. The first failing row is found by a min-reduction, so the
   // outcome does not depend on the thread count.
-  constexpr std::size_t kBlock = 32;
-  const std::size_t blocks = (n + kBlock - 1) / kBlock;
+  const std::size_t block = std::max<std::size_t>(1, balls_per_block);
+  const std::size_t blocks = (n + block - 1) / block;
   std::size_t bad_row = rows;
   std::int64_t batched = 0;
   const bool terms_ready = body_terms_ready_ && ball_kin_.size() == n;
@@ -598,7 +598,7 @@ void Simulation::force_pass(double dt) {
     auto scratch = std::make_unique<BlockScratch>();  // ≈ 60 kB: on the heap, not the thread's stack
 #pragma omp for schedule(static)
     for (std::size_t k = 0; k < blocks; ++k)
-      force_block(k * kBlock, std::min(n, (k + 1) * kBlock), dt, *scratch, bad_row, batched);
+      force_block(k * block, std::min(n, (k + 1) * block), dt, *scratch, bad_row, batched);
   }
   batched_rows_ = batched;
   body_terms_ready_ = true;

@@ -107,6 +107,10 @@ class Simulation {
   // Existing ball-ball contacts go through the batched laws (engine/contact_batch.hpp); false: every
   // row through the row-by-row laws (the two agree to rounding; kept for tests and comparison).
   bool use_batched_kernel = true;
+  // Balls per block of the force pass (a block's contacts fill the batches together; blocks are
+  // the unit of work of the threads). A tuning knob only: results do not depend on it (the batches
+  // pad their lanes, ContactBatch::pad_lanes). 128: docs/performance.md.
+  std::size_t balls_per_block = 128;
   // Rows that went through the batched law in the last force pass.
   std::int64_t batched_rows() const { return batched_rows_; }
 
