@@ -178,8 +178,8 @@ class Simulation {
     bool active = false;
   };
   // Write a row's result into its columns, or delete the contact if it is inactive beyond proximity
-  // (spec §2.5); returns the pair loop's share.
-  RowShare store_row(std::size_t c, const RowOutcome& out, bool want_stiffness);
+  // (spec §2.5); and the pair loop's share into `share`.
+  void store_row(std::size_t c, const RowOutcome& out, bool want_stiffness, RowShare& share);
   // What one thread reuses from block to block.
   struct BlockScratch {
     ContactBatch hill, linear;
