@@ -4,6 +4,7 @@
 
 #include "commands.hpp"
 #include "hilldem/bench/bed_bench.hpp"
+#include "hilldem/bench/memory_bandwidth.hpp"
 #include "hilldem/core/error.hpp"
 
 namespace hilldem::cli {
@@ -11,6 +12,7 @@ namespace hilldem::cli {
 Command add_bench_command(CLI::App& app) {
   auto o = std::make_shared<BedBenchOptions>();
   auto settle_out = std::make_shared<std::string>();
+  auto memory = std::make_shared<bool>(false);
   auto* bench = app.add_subcommand(
       "bench", "Time the dense bed of bench/ (hill model, periodic x-y, floor, gravity, dt 1e-6 s); prints one line");
   bench->add_option("--data", o->data, "LAMMPS data file of the bed (default bench/bed_settled.data)");
@@ -20,9 +22,16 @@ Command add_bench_command(CLI::App& app) {
   bench->add_option("--threads", o->threads, "OpenMP threads (0: default)")->check(CLI::Range(0, 1024));
   bench->add_option("--block", o->block, "balls per block of the force pass (0: the default, 128); a tuning knob, "
                     "results do not depend on it")->check(CLI::Range(0, 1000000));
+  bench->add_flag("--memory", *memory,
+                  "instead of timing the bed: the memory bandwidth of one core (STREAM copy and triad over "
+                  "3 x 256 MiB), the hardware limit of docs/performance.md");
   bench->add_option("--settle", *settle_out,
                     "instead of timing: settle the --data bed under hilldem's laws and write it to this file");
-  return {bench, [o, settle_out] {
+  return {bench, [o, settle_out, memory] {
+            if (*memory) {
+              std::cout << measure_memory_bandwidth().line() << std::endl;
+              return 0;
+            }
             BedBenchOptions opt = *o;
             if (opt.data.empty()) {
               for (const std::string p : {std::string("bench/bed_settled.data"),
