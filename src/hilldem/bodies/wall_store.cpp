@@ -2,14 +2,6 @@
 
 namespace hilldem {
 
-namespace {
-Vec3 axis_vector(int axis) {
-  Vec3 a;
-  a[axis] = 1.0;
-  return a;
-}
-}  // namespace
-
 Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
   const Vec3 ab = b - a, ac = c - a, ap = p - a;
   const double d1 = dot(ab, ap), d2 = dot(ac, ap);
@@ -60,16 +52,6 @@ std::optional<WallTouch> wall_touch(const Wall& w, const Vec3& c, double R) {
     }
   }
   return std::nullopt;
-}
-
-Vec3 wall_point_velocity(const Wall& w, const Vec3& x) {
-  Vec3 v = w.velocity + cross(w.spin, x - w.rotation_center);
-  if (w.shape == WallShape::Cylinder && w.radial_velocity != 0.0) {
-    const Vec3 a = axis_vector(w.axis);
-    const Vec3 rel = x - w.point;
-    v += unit_or_zero(rel - a * dot(rel, a)) * w.radial_velocity;
-  }
-  return v;
 }
 
 void advance_wall(Wall& w, double dt) {

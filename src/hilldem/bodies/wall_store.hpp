@@ -44,6 +44,13 @@ struct Wall {
   std::size_t active_contacts = 0;
 };
 
+// The unit vector of axis 0, 1 or 2 (x, y, z).
+inline Vec3 axis_vector(int axis) {
+  Vec3 a;
+  a[axis] = 1.0;
+  return a;
+}
+
 // Where a ball touches a wall: unit normal from the ball centre towards the wall (piece 1 = ball,
 // piece 2 = wall, spec §1.1) and the signed gap [m] (< 0: overlap).
 struct WallTouch {
@@ -56,7 +63,17 @@ struct WallTouch {
 std::optional<WallTouch> wall_touch(const Wall& w, const Vec3& c, double R);
 
 // Velocity [m/s] of the wall's surface material point at x.
-Vec3 wall_point_velocity(const Wall& w, const Vec3& x);
+HILLDEM_INLINE Vec3 wall_point_velocity(const Wall& w, const Vec3& x) {
+  Vec3 v = w.velocity + cross(w.spin, x - w.rotation_center);
+  if (w.shape == WallShape::Cylinder && w.radial_velocity != 0.0) {
+    const Vec3 a = axis_vector(w.axis);
+    const Vec3 rel = x - w.point;
+    v += unit_or_zero(rel - a * dot(rel, a)) * w.radial_velocity;
+  }
+  return v;
+}
+// (Inline: it runs for every wall row of every step. Out of line, the C5b hill triaxial test was
+// 1.05 × slower, with the same history; inlining wall_touch as well gained nothing more.)
 
 // Advance the wall's geometry by its imposed motion over dt [s].
 void advance_wall(Wall& w, double dt);
