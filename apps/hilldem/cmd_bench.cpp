@@ -1,6 +1,7 @@
 // hilldem bench: particle-steps per second on the dense bed of bench/.
 #include <filesystem>
 #include <iostream>
+#include <string>
 
 #include "commands.hpp"
 #include "hilldem/bench/bed_bench.hpp"
@@ -20,8 +21,11 @@ Command add_bench_command(CLI::App& app) {
   bench->add_option("--steps", o->steps, "timed steps")->check(CLI::Range(1, 100000000));
   bench->add_option("--warmup", o->warmup, "untimed steps first")->check(CLI::Range(0, 100000000));
   bench->add_option("--threads", o->threads, "OpenMP threads (0: default)")->check(CLI::Range(0, 1024));
-  bench->add_option("--block", o->block, "balls per block of the force pass (0: the default, 128); a tuning knob, "
-                    "results do not depend on it")->check(CLI::Range(0, 1000000));
+  bench->add_option("--block", o->block,
+                    "balls per block of the force pass (0: the default, " +
+                        std::to_string(Simulation::kDefaultBallsPerBlock) +
+                        "); a tuning knob, results do not depend on it")
+      ->check(CLI::Range(0, 1000000));
   bench->add_flag("--memory", *memory,
                   "instead of timing the bed: the memory bandwidth of one core (STREAM copy and triad over "
                   "3 x 256 MiB), the hardware limit of docs/performance.md");

@@ -135,8 +135,7 @@ HILLDEM_INLINE void store_lane(const LaneOutputs& o, std::size_t i, bool active,
 
 std::size_t ContactBatch::pad_lanes() {
   static_assert(kLanes % kVector == 0);
-  const std::size_t padded = (size_ + kVector - 1) / kVector * kVector;
-  if (size_ == 0) return 0;
+  const std::size_t padded = (size_ + kVector - 1) / kVector * kVector;  // (0 for an empty batch)
   for (int f = 0; f < kKn; ++f)  // the inputs
     for (std::size_t lane = size_; lane < padded; ++lane) data_[f][lane] = data_[f][size_ - 1];
   return padded;

@@ -110,7 +110,8 @@ class Simulation {
   // Balls per block of the force pass (a block's contacts fill the batches together; blocks are
   // the unit of work of the threads). A tuning knob only: results do not depend on it (the batches
   // pad their lanes, ContactBatch::pad_lanes). 128: docs/performance.md.
-  std::size_t balls_per_block = 128;
+  static constexpr std::size_t kDefaultBallsPerBlock = 128;
+  std::size_t balls_per_block = kDefaultBallsPerBlock;
   // Rows that went through the batched law in the last force pass.
   std::int64_t batched_rows() const { return batched_rows_; }
 
