@@ -27,8 +27,9 @@ Command add_bench_command(CLI::App& app) {
                         "); a tuning knob, results do not depend on it")
       ->check(CLI::Range(0, 1000000));
   bench->add_flag("--memory", *memory,
-                  "instead of timing the bed: the memory bandwidth of one core (STREAM copy and triad over "
-                  "3 x 256 MiB), the hardware limit of docs/performance.md");
+                  "instead of timing the bed: the memory bandwidth of one core in GB/s (STREAM copy and triad, "
+                  "the triad's real traffic with write-allocate, and a read-modify-write update; 3 x 256 MiB), "
+                  "the hardware limit of docs/performance.md");
   bench->add_option("--settle", *settle_out,
                     "instead of timing: settle the --data bed under hilldem's laws and write it to this file");
   return {bench, [o, settle_out, memory] {
