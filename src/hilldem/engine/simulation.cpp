@@ -1,5 +1,7 @@
 #include "hilldem/engine/simulation.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -563,10 +565,13 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, double dt, BlockScr
   // step or density scaling needs them.
   for (std::size_t a = a0; a < a1; ++a) {
     Vec3 f, m;
+    std::uint32_t contacts_of_a = 0;
     for (std::size_t c = first_rows_[a]; c < first_rows_[a + 1]; ++c) {
       f += shares[c - r0].force;
       m += shares[c - r0].moment;
+      contacts_of_a += contacts.exists[c];
     }
+    ball_contacts_[a] = contacts_of_a;  // for the next pass's split_work
     first_force_[a] = f;
     first_moment_[a] = m;
     if (want_stiffness) {
@@ -578,18 +583,42 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, double dt, BlockScr
   }
 }
 
+void Simulation::split_work(int threads) {
+  // Work of ball i in the pass, in units of a neighbour row that is not a contact: its rows, three
+  // more for each that was a contact in the last pass (gather, law and scatter), and two for the
+  // ball itself (its record, its half of the force sum). Threads get ranges of equal work, not of
+  // equal numbers of balls: rows and contacts per ball vary across a specimen (denser at the bottom
+  // of a bed, none above its surface), and with equal numbers of balls one thread waited at the end
+  // of the pass (a third of its time on an unsettled bed).
+  const std::size_t n = balls.size();
+  work_start_.assign(static_cast<std::size_t>(threads) + 1, n);
+  work_start_[0] = 0;
+  if (threads <= 1 || n == 0) return;
+  const bool have_counts = ball_contacts_.size() == n;
+  std::vector<std::uint64_t> prefix(n + 1, 0);
+  for (std::size_t i = 0; i < n; ++i)
+    prefix[i + 1] = prefix[i] + 2 + (first_rows_[i + 1] - first_rows_[i]) + (have_counts ? 3 * ball_contacts_[i] : 0);
+  for (int t = 1; t < threads; ++t) {
+    const std::uint64_t target = prefix[n] * static_cast<std::uint64_t>(t) / static_cast<std::uint64_t>(threads);
+    work_start_[t] = static_cast<std::size_t>(std::lower_bound(prefix.begin(), prefix.end(), target) - prefix.begin());
+  }
+}
+
 void Simulation::force_pass(double dt) {
   const std::size_t rows = contacts.size();
   const std::size_t n = balls.size();
   // Blocks of balls, each with its own rows (ball-ball rows are sorted by their first ball); each
-  // row writes only its own columns. The first failing row is found by a min-reduction, so the
-  // outcome does not depend on the thread count.
+  // row writes only its own columns. Each thread takes a range of balls of equal work
+  // (split_work) in blocks of balls_per_block from its start: results depend neither on the
+  // blocks (ContactBatch::pad_lanes) nor, then, on the thread count. The first failing row is found
+  // by a min-reduction, so the outcome does not depend on the thread count.
   const std::size_t block = std::max<std::size_t>(1, balls_per_block);
-  const std::size_t blocks = (n + block - 1) / block;
   std::size_t bad_row = rows;
   std::int64_t batched = 0;
   const bool terms_ready = body_terms_ready_ && ball_kin_.size() == n;
   ball_kin_.resize(n);
+  const std::size_t wall_rows = wall_rows_.size();
+  ball_contacts_.resize(n);
 #pragma omp parallel reduction(min : bad_row) reduction(+ : batched) if (n > kParallelMin)
   {
     // What the pair loop reads of each ball, in one record (two cache lines): one memory stream per
@@ -607,18 +636,22 @@ void Simulation::force_pass(double dt) {
         k.terms = hill_body_terms(balls.radius[i], balls.young_mod[i], balls.pois_ratio[i], balls.mass[i]);
     }
     auto scratch = std::make_unique<BlockScratch>();  // ≈ 60 kB: on the heap, not the thread's stack
+#pragma omp single
+    split_work(omp_get_num_threads());
+    const auto t = static_cast<std::size_t>(omp_get_thread_num());
+    const std::size_t first = work_start_[t], last = work_start_[t + 1];
+    for (std::size_t a = first; a < last; a += block)
+      force_block(a, std::min(last, a + block), dt, *scratch, bad_row, batched);
+    // The wall rows (row by row), shared out the same way whatever their number: no thread waits
+    // for another to do them alone.
 #pragma omp for schedule(static)
-    for (std::size_t k = 0; k < blocks; ++k)
-      force_block(k * block, std::min(n, (k + 1) * block), dt, *scratch, bad_row, batched);
+    for (std::size_t k = 0; k < wall_rows; ++k) {
+      const std::size_t c = wall_rows_[k];
+      if (!force_row(c, dt).ok) bad_row = std::min(bad_row, c);
+    }
   }
   batched_rows_ = batched;
   body_terms_ready_ = true;
-  const std::size_t wall_rows = wall_rows_.size();
-#pragma omp parallel for schedule(static) reduction(min : bad_row) if (wall_rows > kParallelMin)
-  for (std::size_t k = 0; k < wall_rows; ++k) {
-    const std::size_t c = wall_rows_[k];
-    if (!force_row(c, dt).ok) bad_row = std::min(bad_row, c);
-  }
   if (bad_row < rows) {
     const ContactKey& key = contacts.key[bad_row];
     std::ostringstream msg;

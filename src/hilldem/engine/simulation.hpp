@@ -156,6 +156,8 @@ class Simulation {
   void build_row_lists();  // per-ball row lists (CSR) and wall rows from the current rows
   void rebuild_if_needed();
   void force_pass(double dt);
+  // work_start_[t]: the first ball of thread t's range in the force pass, cut at equal work.
+  void split_work(int threads);
   // What a row gives the ball it is summed into inside the pair loop (piece 1 of a ball-ball row).
   struct RowShare {
     Vec3 force;   // −F_c [N] (zero when the row is not an active contact)
@@ -238,7 +240,9 @@ class Simulation {
     Vec3 spin;             // [rad/s]
     HillBodyTerms terms;   // for the hill mappings
   };
-  std::vector<BallKin> ball_kin_;            // per ball, what the batched pair loop reads
+  std::vector<BallKin> ball_kin_;
+  std::vector<std::uint32_t> ball_contacts_;  // per ball, its rows that were contacts in the last pass
+  std::vector<std::size_t> work_start_;        // threads' ranges of balls in the force pass (split_work)            // per ball, what the batched pair loop reads
   bool body_terms_ready_ = false;            // ball_kin_[i].terms are up to date (see force_pass)
   std::vector<double> scaled_mass_, scaled_inertia_;  // density scaling [kg], [kg m²]
 };
