@@ -8,8 +8,10 @@
 # LAMMPS runs bench/lammps/in.bench with pair granular (Hertz-Mindlin, Tsuji e = 0.9, mu = 0.4);
 # hilldem runs `hilldem bench` (hill model: E 29 GPa, nu 0.15, mu 0.4, damp_con 0.07 ~ e = 0.906).
 # Prints one line per run and the ratio hilldem / LAMMPS in particle-steps per second. With repeats > 1
-# the two codes run in turn (L H L H ...) and the ratio is that of the best run of each: the machines
-# here are shared, and their speed drifts by tens of per cent within minutes.
+# the two codes run in turn (L H L H ...) and two ratios are printed: that of the best run of each,
+# and the median of the runs' own ratios (each hilldem run against the LAMMPS run before it). The
+# machines here are shared, and their speed drifts by tens of per cent within minutes: when it
+# changes between runs, best against best compares two different machines, the median less so.
 # LAMMPS is Debian's `lammps` package (installed here if missing).
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
@@ -49,4 +51,11 @@ for rep in 1 3; do
   lmp_rate=$(best < "$work/lmp.rates")
   hd_rate=$(best < "$work/hd.rates")
   python3 -c "print('ratio hilldem/lammps (%d spheres, %s thread(s), best of %s each): %.2f' % ($rep*$rep*11200, '$threads', '$repeats', $hd_rate/$lmp_rate))"
+  # The median of the runs' own ratios (each hilldem run against the LAMMPS run just before it):
+  # steadier than best against best when the machine changes speed between runs.
+  paste "$work/hd.rates" "$work/lmp.rates" | python3 -c "
+import statistics, sys
+r = [float(h) / float(l) for h, l in (line.split() for line in sys.stdin)]
+print('ratio hilldem/lammps (%d spheres, %s thread(s), median of %d side-by-side runs): %.2f (range %.2f-%.2f)'
+      % ($rep * $rep * 11200, '$threads', len(r), statistics.median(r), min(r), max(r)))"
 done
