@@ -448,7 +448,7 @@ HILLDEM_INLINE void Simulation::store_row(std::size_t c, const RowOutcome& out, 
 }
 
 void Simulation::force_block(std::size_t a0, std::size_t a1, double dt, BlockScratch& scratch, std::size_t& bad_row,
-                             std::int64_t& batched_count) {
+                             std::int64_t& batched_count, bool count_contacts) {
   // Rows of balls a0..a1-1 (ball-ball rows, contiguous). Existing hill and linear contacts go through
   // the batches; new contacts and the shear-displacement tracking through force_row().
   const std::size_t r0 = first_rows_[a0], r1 = first_rows_[a1];
@@ -561,17 +561,20 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, double dt, BlockScr
   }
   if (hill.size() > 0) flush(hill);
   if (linear.size() > 0) flush(linear);
+  if (count_contacts)  // for the next pass's split_work (a separate loop: the sum below stays as it was)
+    for (std::size_t a = a0; a < a1; ++a) {
+      std::uint32_t count = 0;
+      for (std::size_t c = first_rows_[a]; c < first_rows_[a + 1]; ++c) count += contacts.exists[c];
+      ball_contacts_[a] = count;
+    }
   // Ball a's half of the force sum, its rows in row order; and of its stiffness sums when the time
   // step or density scaling needs them.
   for (std::size_t a = a0; a < a1; ++a) {
     Vec3 f, m;
-    std::uint32_t contacts_of_a = 0;
     for (std::size_t c = first_rows_[a]; c < first_rows_[a + 1]; ++c) {
       f += shares[c - r0].force;
       m += shares[c - r0].moment;
-      contacts_of_a += contacts.exists[c];
     }
-    ball_contacts_[a] = contacts_of_a;  // for the next pass's split_work
     first_force_[a] = f;
     first_moment_[a] = m;
     if (want_stiffness) {
@@ -595,7 +598,9 @@ void Simulation::split_work(int threads) {
   work_start_[0] = 0;
   if (threads <= 1 || n == 0) return;
   const bool have_counts = ball_contacts_.size() == n;
-  std::vector<std::uint64_t> prefix(n + 1, 0);
+  std::vector<std::uint64_t>& prefix = work_prefix_;
+  prefix.resize(n + 1);
+  prefix[0] = 0;
   for (std::size_t i = 0; i < n; ++i)
     prefix[i + 1] = prefix[i] + 2 + (first_rows_[i + 1] - first_rows_[i]) + (have_counts ? 3 * ball_contacts_[i] : 0);
   for (int t = 1; t < threads; ++t) {
@@ -640,8 +645,10 @@ void Simulation::force_pass(double dt) {
     split_work(omp_get_num_threads());
     const auto t = static_cast<std::size_t>(omp_get_thread_num());
     const std::size_t first = work_start_[t], last = work_start_[t + 1];
+    // One thread needs no split, nor the counts it is made from (3 % of a step in cache).
+    const bool count_contacts = omp_get_num_threads() > 1;
     for (std::size_t a = first; a < last; a += block)
-      force_block(a, std::min(last, a + block), dt, *scratch, bad_row, batched);
+      force_block(a, std::min(last, a + block), dt, *scratch, bad_row, batched, count_contacts);
     // The wall rows (row by row), shared out the same way whatever their number: no thread waits
     // for another to do them alone.
 #pragma omp for schedule(static)

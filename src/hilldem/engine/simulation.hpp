@@ -196,8 +196,9 @@ class Simulation {
   };
   // The rows of balls a0..a1-1 (ball-ball), with their half of the force sum; bad_row: the lowest
   // row with a non-finite force; batched: + the rows that went through a batch.
+  // count_contacts: also count each ball's contacts for the next pass's split_work.
   void force_block(std::size_t a0, std::size_t a1, double dt, BlockScratch& scratch, std::size_t& bad_row,
-                   std::int64_t& batched);
+                   std::int64_t& batched, bool count_contacts);
   // Second half of the force sum: each ball adds the rows it did not sum in the pair loop.
   void collect_forces();
   void compute_mapping(ContactStore& store, std::size_t c) const;
@@ -242,7 +243,8 @@ class Simulation {
   };
   std::vector<BallKin> ball_kin_;
   std::vector<std::uint32_t> ball_contacts_;  // per ball, its rows that were contacts in the last pass
-  std::vector<std::size_t> work_start_;        // threads' ranges of balls in the force pass (split_work)            // per ball, what the batched pair loop reads
+  std::vector<std::size_t> work_start_;        // threads' ranges of balls in the force pass (split_work)
+  std::vector<std::uint64_t> work_prefix_;     // split_work's running sum of work per ball            // per ball, what the batched pair loop reads
   bool body_terms_ready_ = false;            // ball_kin_[i].terms are up to date (see force_pass)
   std::vector<double> scaled_mass_, scaled_inertia_;  // density scaling [kg], [kg m²]
 };
