@@ -422,8 +422,10 @@ int main(int argc, char** argv) {
         const double d2 = dx * dx + dy * dy + dz * dz, rsum = ka.r + kb.r;
         History& h = hist[p];
         if (d2 >= rsum * rsum || (rowmeta && !exists[p])) {
-          h.hx = h.hy = h.hz = 0;
-          if (late_mode) row_out[p] = Acc{0, 0, 0, 0, 0, 0};
+          // A pair apart forgets its shear force, and gives no force: written only when there is
+          // something to clear (as hilldem, whose rows that are not contacts are not written).
+          if (h.hx != 0.0 || h.hy != 0.0 || h.hz != 0.0) h.hx = h.hy = h.hz = 0;
+          if (late_mode && row_out[p].fx != 0.0) row_out[p] = Acc{0, 0, 0, 0, 0, 0};
           continue;
         }
         ++touching;
