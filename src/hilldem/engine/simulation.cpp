@@ -743,15 +743,18 @@ double Simulation::estimate_timestep() const {
   // Per-body sums of the contact-returned stiffnesses (spec §4): k_tran = Σ(k̂_n + k̂_s),
   // k_rot = Σ k̂_s |x_c − x|². Δt_crit = min(√(m/k_tran), √(I/k_rot)). The stiffnesses were stored
   // by the last force pass (hill Eqs. 19-21; linear k_n, k_s).
+  // The minimum is taken over the squares m/k_tran, I/k_rot [s²] and rooted once: √ is monotonic and
+  // correctly rounded, so √(min x) is bit for bit min √x, without two roots per ball.
   const std::size_t n = balls.size();
-  double crit = std::numeric_limits<double>::infinity();
-#pragma omp parallel for schedule(static) reduction(min : crit) if (n > kParallelMin)
+  double crit2 = std::numeric_limits<double>::infinity();
+#pragma omp parallel for schedule(static) reduction(min : crit2) if (n > kParallelMin)
   for (std::size_t i = 0; i < n; ++i) {
     double k_tran, k_rot;
     ball_stiffness(i, k_tran, k_rot);
-    if (k_tran > 0.0) crit = std::min(crit, std::sqrt(balls.mass[i] / k_tran));
-    if (k_rot > 0.0) crit = std::min(crit, std::sqrt(balls.inertia[i] / k_rot));
+    if (k_tran > 0.0) crit2 = std::min(crit2, balls.mass[i] / k_tran);
+    if (k_rot > 0.0) crit2 = std::min(crit2, balls.inertia[i] / k_rot);
   }
+  const double crit = std::sqrt(crit2);
   return std::isfinite(crit) ? settings.timestep_safety * crit : 0.0;
 }
 
