@@ -241,10 +241,11 @@ class Simulation {
     Vec3 spin;             // [rad/s]
     HillBodyTerms terms;   // for the hill mappings
   };
-  std::vector<BallKin> ball_kin_;
-  std::vector<std::uint32_t> ball_contacts_;  // per ball, its rows that were contacts in the last pass
+  std::vector<BallKin> ball_kin_;             // per ball, what the batched pair loop reads
+  // Per ball, its rows that were contacts in the last pass with more than one thread (split_work).
+  std::vector<std::uint32_t> ball_contacts_;
   std::vector<std::size_t> work_start_;        // threads' ranges of balls in the force pass (split_work)
-  std::vector<std::uint64_t> work_prefix_;     // split_work's running sum of work per ball            // per ball, what the batched pair loop reads
+  std::vector<std::uint64_t> work_prefix_;     // split_work's running sum of work per ball
   bool body_terms_ready_ = false;            // ball_kin_[i].terms are up to date (see force_pass)
   std::vector<double> scaled_mass_, scaled_inertia_;  // density scaling [kg], [kg m²]
 };
