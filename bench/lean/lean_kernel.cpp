@@ -190,6 +190,19 @@ int main(int argc, char** argv) {
   const double g = -9.81;
   long contacts_seen = 0;
 
+  // The floor (linear, frictionless) and the law of motion of ball a (no local damping, as the bench).
+  auto move = [&](std::size_t a) {
+    Kin& k = kin[a];
+    Spin& s = spin[a];
+    const Acc& f = acc[a];
+    const double pen = k.r - k.z;
+    const double floor_f = pen > 0 ? floor_kn[a] * pen : 0.0;
+    k.vx += f.fx * k.inv_m * dt;
+    k.vy += f.fy * k.inv_m * dt;
+    k.vz += ((f.fz + floor_f) * k.inv_m + g) * dt;
+    s.wx += f.tx * inv_i[a] * dt, s.wy += f.ty * inv_i[a] * dt, s.wz += f.tz * inv_i[a] * dt;
+    k.x += k.vx * dt, k.y += k.vy * dt, k.z += k.vz * dt;
+  };
   auto step = [&](bool count) {
     for (std::size_t a = 0; a < n; ++a) acc[a] = Acc{0, 0, 0, 0, 0, 0};
     long touching = 0;
@@ -270,19 +283,7 @@ int main(int argc, char** argv) {
       Acc& ta = acc[a];
       ta.fx += fa.fx, ta.fy += fa.fy, ta.fz += fa.fz, ta.tx += fa.tx, ta.ty += fa.ty, ta.tz += fa.tz;
     }
-    // floor (linear, frictionless stand-in) and the law of motion
-    for (std::size_t a = 0; a < n; ++a) {
-      Kin& k = kin[a];
-      Spin& s = spin[a];
-      const Acc& f = acc[a];
-      const double pen = k.r - k.z;
-      const double floor_f = pen > 0 ? floor_kn[a] * pen : 0.0;
-      k.vx += f.fx * k.inv_m * dt;
-      k.vy += f.fy * k.inv_m * dt;
-      k.vz += ((f.fz + floor_f) * k.inv_m + g) * dt;
-      s.wx += f.tx * inv_i[a] * dt, s.wy += f.ty * inv_i[a] * dt, s.wz += f.tz * inv_i[a] * dt;
-      k.x += k.vx * dt, k.y += k.vy * dt, k.z += k.vz * dt;
-    }
+    for (std::size_t a = 0; a < n; ++a) move(a);
     if (count) contacts_seen = touching;
   };
   // The same physics with the law over lanes of 64 touching pairs (gather, vectorised law, scatter),
@@ -456,37 +457,26 @@ int main(int argc, char** argv) {
         acc[a] = f;
       }
     for (std::size_t a = 0; a < n; ++a) {
-      Kin& k = kin[a];
-      Spin& s = spin[a];
-      const Acc& f = acc[a];
-      const double pen = k.r - k.z;
-      const double floor_f = pen > 0 ? floor_kn[a] * pen : 0.0;
-      k.vx += f.fx * k.inv_m * dt;
-      k.vy += f.fy * k.inv_m * dt;
-      k.vz += ((f.fz + floor_f) * k.inv_m + g) * dt;
-      s.wx += f.tx * inv_i[a] * dt, s.wy += f.ty * inv_i[a] * dt, s.wz += f.tz * inv_i[a] * dt;
-      k.x += k.vx * dt, k.y += k.vy * dt, k.z += k.vz * dt;
-      if (copy) col_pos[a] = {k.x, k.y, k.z}, col_vel[a] = {k.vx, k.vy, k.vz}, col_spin[a] = {s.wx, s.wy, s.wz};
+      move(a);
+      if (copy) {
+        const Kin& k = kin[a];
+        const Spin& s = spin[a];
+        col_pos[a] = {k.x, k.y, k.z}, col_vel[a] = {k.vx, k.vy, k.vz}, col_spin[a] = {s.wx, s.wy, s.wz};
+      }
     }
     if (count) contacts_seen = touching;
   };
-  const bool use_batched = flags & 1;
-  if (use_batched) {
-    for (long s = 0; s < steps / 5; ++s) step_batched(false);
+  // Warm-up (a fifth of the steps), then the timed steps; the contacts are counted on the last one.
+  auto run = [&](auto& one_step) {
+    for (long k = 0; k < steps / 5; ++k) one_step(false);
     const auto t0 = std::chrono::steady_clock::now();
-    for (long s = 0; s < steps; ++s) step_batched(s == steps - 1);
+    for (long k = 0; k < steps; ++k) one_step(k == steps - 1);
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::printf("mode=%d particles=%zu steps=%ld wall_s=%.3f particle_steps_per_s=%.4g contacts_per_particle=%.3f "
                 "pairs_per_particle=%.3f\n",
                 flags, n, steps, wall, n * steps / wall, 2.0 * contacts_seen / n, static_cast<double>(pairs) / n);
-    return 0;
-  }
-  for (long s = 0; s < steps / 5; ++s) step(false);  // warm-up
-  const auto t0 = std::chrono::steady_clock::now();
-  for (long s = 0; s < steps; ++s) step(s == steps - 1);
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::printf("mode=0 particles=%zu steps=%ld wall_s=%.3f particle_steps_per_s=%.4g contacts_per_particle=%.3f "
-              "pairs_per_particle=%.3f\n",
-              n, steps, wall, n * steps / wall, 2.0 * contacts_seen / n, static_cast<double>(pairs) / n);
+  };
+  if (flags & 1) run(step_batched);
+  else run(step);
   return 0;
 }
