@@ -50,6 +50,70 @@ struct History {
   double nx, ny, nz, hx, hy, hz;
 };
 
+// The dry hill law of one touching pair (spec §1.1-1.3, hill Eqs. 13-18 with F^m = 0), every branch a
+// select so that the batched mode's lane loop vectorises it; the row-by-row mode calls it per pair.
+struct PairIn {
+  double dx, dy, dz, ra, rb;             // x_b − x_a [m], radii [m]
+  double vax, vay, vaz, vbx, vby, vbz;   // velocities [m/s]
+  double wax, way, waz, wbx, wby, wbz;   // spins [rad/s]
+  double ira, irb, ima, imb;             // 1/R [1/m], 1/m [1/kg]
+  double nox, noy, noz, hx, hy, hz;      // last normal, shear force [N]
+};
+struct PairOut {
+  double nx, ny, nz, hx, hy, hz;  // normal, shear force carried to the next step [N]
+  double fx, fy, fz;              // force on b [N]
+  double arm1, arm2;              // R + g/2 of a and b [m]
+};
+struct LawConstants {
+  double c_kn, c_ks, gamma, mu, dt;
+};
+static inline __attribute__((always_inline)) PairOut pair_law(const PairIn& p, const LawConstants& k) {
+  const double dist = std::sqrt(p.dx * p.dx + p.dy * p.dy + p.dz * p.dz), inv = 1 / dist;
+  const double nx = p.dx * inv, ny = p.dy * inv, nz = p.dz * inv;
+  const double overlap = p.ra + p.rb - dist;
+  const double arm1 = p.ra - 0.5 * overlap, arm2 = p.rb - 0.5 * overlap;
+  // relative velocity at the contact point
+  const double ax = nx * arm1, ay = ny * arm1, az = nz * arm1, bx = nx * arm2, by = ny * arm2, bz = nz * arm2;
+  const double v1x = p.vax + (p.way * az - p.waz * ay), v1y = p.vay + (p.waz * ax - p.wax * az),
+               v1z = p.vaz + (p.wax * ay - p.way * ax);
+  const double v2x = p.vbx - (p.wby * bz - p.wbz * by), v2y = p.vby - (p.wbz * bx - p.wbx * bz),
+               v2z = p.vbz - (p.wbx * by - p.wby * bx);
+  const double rx = v2x - v1x, ry = v2y - v1y, rz = v2z - v1z;
+  const double vn = rx * nx + ry * ny + rz * nz;
+  const double sx = rx - nx * vn, sy = ry - ny * vn, sz = rz - nz * vn;
+  // mapping (Table 4)
+  const double re = 1 / (p.ira + p.irb), me = 1 / (p.ima + p.imb);
+  const double sre = std::sqrt(re), kn = k.c_kn * sre, ks = k.c_ks * sre;
+  const double bn = k.gamma * std::sqrt(me * kn), bs = k.gamma * std::sqrt(me * ks);
+  // the stored shear force carried into the current plane: tilt, twist, normal part dropped, magnitude kept
+  const double mag2 = p.hx * p.hx + p.hy * p.hy + p.hz * p.hz;
+  const double tx = p.noy * nz - p.noz * ny, ty = p.noz * nx - p.nox * nz, tz = p.nox * ny - p.noy * nx;
+  const double spin_n = 0.5 * ((p.wax + p.wbx) * nx + (p.way + p.wby) * ny + (p.waz + p.wbz) * nz) * k.dt;
+  const double qx = nx * spin_n, qy = ny * spin_n, qz = nz * spin_n;
+  const double g1x = p.hx - (p.hy * tz - p.hz * ty), g1y = p.hy - (p.hz * tx - p.hx * tz),
+               g1z = p.hz - (p.hx * ty - p.hy * tx);
+  double gx = g1x - (g1y * qz - g1z * qy), gy = g1y - (g1z * qx - g1x * qz), gz = g1z - (g1x * qy - g1y * qx);
+  const double gn = gx * nx + gy * ny + gz * nz;
+  gx -= nx * gn, gy -= ny * gn, gz -= nz * gn;
+  const double g2 = gx * gx + gy * gy + gz * gz;
+  const double sc = g2 > 0 ? std::sqrt(mag2 / g2) : 1.0;
+  double hx = mag2 > 0 ? gx * sc : p.hx, hy = mag2 > 0 ? gy * sc : p.hy, hz = mag2 > 0 ? gz * sc : p.hz;
+  // Hertz-Mindlin with Tsuji dashpots, incremental shear, Coulomb clamp
+  const double root2 = std::sqrt(overlap), root4 = std::sqrt(root2);
+  const double fn = kn * overlap * root2 - bn * root4 * vn;
+  const double strength = std::max(0.0, k.mu * fn);
+  const double inc = ks * root2 * k.dt;
+  hx -= sx * inc, hy -= sy * inc, hz -= sz * inc;
+  const double hm = std::sqrt(hx * hx + hy * hy + hz * hz);
+  const double c1 = hm > strength ? (hm > 0 ? strength / hm : 0.0) : 1.0;
+  hx *= c1, hy *= c1, hz *= c1;
+  const double dmp = -bs * root4;
+  const double ex0 = hx + sx * dmp, ey0 = hy + sy * dmp, ez0 = hz + sz * dmp;
+  const double tm = std::sqrt(ex0 * ex0 + ey0 * ey0 + ez0 * ez0);
+  const double c2 = tm > strength ? strength / tm : 1.0;
+  return {nx, ny, nz, hx, hy, hz, nx * fn + ex0 * c2, ny * fn + ey0 * c2, nz * fn + ez0 * c2, arm1, arm2};
+}
+
 int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr, "usage: hilldem_lean_reference DATA [replicate=1] [steps=1000] [mode=1]\n");
@@ -184,6 +248,7 @@ int main(int argc, char** argv) {
   const double E = 29e9, nu = 0.15, mu = 0.4, gamma = 0.07, dt = 1e-6;
   const double Ee = E / (2 * (1 - nu * nu)), Ge = E / (4 * (2 - nu) * (1 + nu));
   const double c_kn = 4.0 / 3.0 * Ee, c_ks = 8 * Ge;
+  const LawConstants law_k{c_kn, c_ks, gamma, mu, dt};
   // The floor: k_n = pi R^2 E* / R = pi R E* per ball (hilldem's linear ball-wall mapping), no shear.
   std::vector<double> floor_kn(n);
   for (std::size_t i = 0; i < n; ++i) floor_kn[i] = M_PI * kin[i].r * E;
@@ -222,57 +287,13 @@ int main(int argc, char** argv) {
         }
         ++touching;
         const Spin& sb = spin[b];
-        const double dist = std::sqrt(d2), inv = 1 / dist;
-        const double nx = dx * inv, ny = dy * inv, nz = dz * inv;
-        const double overlap = rsum - dist;
-        const double arm1 = ka.r - 0.5 * overlap, arm2 = kb.r - 0.5 * overlap;
-        // relative velocity at the contact point
-        const double ax = nx * arm1, ay = ny * arm1, az = nz * arm1, bx = nx * arm2, by = ny * arm2, bz = nz * arm2;
-        const double v1x = ka.vx + (sa.wy * az - sa.wz * ay), v1y = ka.vy + (sa.wz * ax - sa.wx * az),
-                     v1z = ka.vz + (sa.wx * ay - sa.wy * ax);
-        const double v2x = kb.vx - (sb.wy * bz - sb.wz * by), v2y = kb.vy - (sb.wz * bx - sb.wx * bz),
-                     v2z = kb.vz - (sb.wx * by - sb.wy * bx);
-        const double rx = v2x - v1x, ry = v2y - v1y, rz = v2z - v1z;
-        const double vn = rx * nx + ry * ny + rz * nz;
-        const double sx = rx - nx * vn, sy = ry - ny * vn, sz = rz - nz * vn;
-        // mapping
-        const double re = 1 / (sa.inv_r + sb.inv_r), me = 1 / (ka.inv_m + kb.inv_m);
-        const double sre = std::sqrt(re), kn = c_kn * sre, ks = c_ks * sre;
-        const double bn = gamma * std::sqrt(me * kn), bs = gamma * std::sqrt(me * ks);
-        // history carried into the plane
-        double hx = h.hx, hy = h.hy, hz = h.hz;
-        const double mag2 = hx * hx + hy * hy + hz * hz;
-        if (mag2 > 0) {
-          const double tx = h.ny * nz - h.nz * ny, ty = h.nz * nx - h.nx * nz, tz = h.nx * ny - h.ny * nx;
-          const double spin_n = 0.5 * ((sa.wx + sb.wx) * nx + (sa.wy + sb.wy) * ny + (sa.wz + sb.wz) * nz) * dt;
-          const double qx = nx * spin_n, qy = ny * spin_n, qz = nz * spin_n;
-          const double g1x = hx - (hy * tz - hz * ty), g1y = hy - (hz * tx - hx * tz), g1z = hz - (hx * ty - hy * tx);
-          double gx = g1x - (g1y * qz - g1z * qy), gy = g1y - (g1z * qx - g1x * qz), gz = g1z - (g1x * qy - g1y * qx);
-          const double gn = gx * nx + gy * ny + gz * nz;
-          gx -= nx * gn, gy -= ny * gn, gz -= nz * gn;
-          const double g2 = gx * gx + gy * gy + gz * gz;
-          const double sc = g2 > 0 ? std::sqrt(mag2 / g2) : 1.0;
-          hx = gx * sc, hy = gy * sc, hz = gz * sc;
-        }
-        const double root2 = std::sqrt(overlap), root4 = std::sqrt(root2);
-        const double fn = kn * overlap * root2 - bn * root4 * vn;
-        const double strength = std::max(0.0, mu * fn);
-        const double inc = ks * root2 * dt;
-        hx -= sx * inc, hy -= sy * inc, hz -= sz * inc;
-        const double hm = std::sqrt(hx * hx + hy * hy + hz * hz);
-        if (hm > strength) {
-          const double c = hm > 0 ? strength / hm : 0;
-          hx *= c, hy *= c, hz *= c;
-        }
-        const double dmp = -bs * root4;
-        double ex = hx + sx * dmp, ey = hy + sy * dmp, ez = hz + sz * dmp;
-        const double tm = std::sqrt(ex * ex + ey * ey + ez * ez);
-        if (tm > strength) {
-          const double c = strength / tm;
-          ex *= c, ey *= c, ez *= c;
-        }
-        h = History{nx, ny, nz, hx, hy, hz};
-        const double Fx = nx * fn + ex, Fy = ny * fn + ey, Fz = nz * fn + ez;  // on b
+        const PairOut o = pair_law(PairIn{dx, dy, dz, ka.r, kb.r, ka.vx, ka.vy, ka.vz, kb.vx, kb.vy, kb.vz, sa.wx, sa.wy,
+                                          sa.wz, sb.wx, sb.wy, sb.wz, sa.inv_r, sb.inv_r, ka.inv_m, kb.inv_m, h.nx, h.ny,
+                                          h.nz, h.hx, h.hy, h.hz},
+                                   law_k);
+        h = History{o.nx, o.ny, o.nz, o.hx, o.hy, o.hz};
+        const double nx = o.nx, ny = o.ny, nz = o.nz, arm1 = o.arm1, arm2 = o.arm2;
+        const double Fx = o.fx, Fy = o.fy, Fz = o.fz;  // on b
         const double cx = ny * Fz - nz * Fy, cy = nz * Fx - nx * Fz, cz = nx * Fy - ny * Fx;  // n × F
         fa.fx -= Fx, fa.fy -= Fy, fa.fz -= Fz;
         fa.tx -= arm1 * cx, fa.ty -= arm1 * cy, fa.tz -= arm1 * cz;
@@ -330,54 +351,16 @@ int main(int argc, char** argv) {
       for (int i = cnt; i < m; ++i) lane[f][i] = lane[f][cnt - 1];
 #pragma omp simd
     for (int i = 0; i < m; ++i) {
-      const double dx = lane[DX][i], dy = lane[DY][i], dz = lane[DZ][i];
-      const double dist = std::sqrt(dx * dx + dy * dy + dz * dz), inv = 1 / dist;
-      const double nx = dx * inv, ny = dy * inv, nz = dz * inv;
-      const double overlap = lane[RA][i] + lane[RB][i] - dist;
-      const double arm1 = lane[RA][i] - 0.5 * overlap, arm2 = lane[RB][i] - 0.5 * overlap;
-      const double wax = lane[WAX][i], way = lane[WAY][i], waz = lane[WAZ][i];
-      const double wbx = lane[WBX][i], wby = lane[WBY][i], wbz = lane[WBZ][i];
-      const double ax = nx * arm1, ay = ny * arm1, az = nz * arm1, bx = nx * arm2, by = ny * arm2, bz = nz * arm2;
-      const double v1x = lane[VAX][i] + (way * az - waz * ay), v1y = lane[VAY][i] + (waz * ax - wax * az),
-                   v1z = lane[VAZ][i] + (wax * ay - way * ax);
-      const double v2x = lane[VBX][i] - (wby * bz - wbz * by), v2y = lane[VBY][i] - (wbz * bx - wbx * bz),
-                   v2z = lane[VBZ][i] - (wbx * by - wby * bx);
-      const double rx = v2x - v1x, ry = v2y - v1y, rz = v2z - v1z;
-      const double vn = rx * nx + ry * ny + rz * nz;
-      const double sx = rx - nx * vn, sy = ry - ny * vn, sz = rz - nz * vn;
-      const double re = 1 / (lane[IRA][i] + lane[IRB][i]), me = 1 / (lane[IMA][i] + lane[IMB][i]);
-      const double sre = std::sqrt(re), kn = c_kn * sre, ks = c_ks * sre;
-      const double bn = gamma * std::sqrt(me * kn), bs = gamma * std::sqrt(me * ks);
-      const double h0x = lane[HX][i], h0y = lane[HY][i], h0z = lane[HZ][i];
-      const double ox = lane[NOX][i], oy = lane[NOY][i], oz = lane[NOZ][i];
-      const double mag2 = h0x * h0x + h0y * h0y + h0z * h0z;
-      const double tx = oy * nz - oz * ny, ty = oz * nx - ox * nz, tz = ox * ny - oy * nx;
-      const double spin_n = 0.5 * ((wax + wbx) * nx + (way + wby) * ny + (waz + wbz) * nz) * dt;
-      const double qx = nx * spin_n, qy = ny * spin_n, qz = nz * spin_n;
-      const double g1x = h0x - (h0y * tz - h0z * ty), g1y = h0y - (h0z * tx - h0x * tz), g1z = h0z - (h0x * ty - h0y * tx);
-      double gx = g1x - (g1y * qz - g1z * qy), gy = g1y - (g1z * qx - g1x * qz), gz = g1z - (g1x * qy - g1y * qx);
-      const double gn = gx * nx + gy * ny + gz * nz;
-      gx -= nx * gn, gy -= ny * gn, gz -= nz * gn;
-      const double g2 = gx * gx + gy * gy + gz * gz;
-      const double sc = g2 > 0 ? std::sqrt(mag2 / g2) : 1.0;
-      double hx = mag2 > 0 ? gx * sc : h0x, hy = mag2 > 0 ? gy * sc : h0y, hz = mag2 > 0 ? gz * sc : h0z;
-      const double root2 = std::sqrt(overlap), root4 = std::sqrt(root2);
-      const double fn = kn * overlap * root2 - bn * root4 * vn;
-      const double strength = std::max(0.0, mu * fn);
-      const double inc = ks * root2 * dt;
-      hx -= sx * inc, hy -= sy * inc, hz -= sz * inc;
-      const double hm = std::sqrt(hx * hx + hy * hy + hz * hz);
-      const double c1 = hm > strength ? (hm > 0 ? strength / hm : 0.0) : 1.0;
-      hx *= c1, hy *= c1, hz *= c1;
-      const double dmp = -bs * root4;
-      const double ex0 = hx + sx * dmp, ey0 = hy + sy * dmp, ez0 = hz + sz * dmp;
-      const double tm = std::sqrt(ex0 * ex0 + ey0 * ey0 + ez0 * ez0);
-      const double c2 = tm > strength ? strength / tm : 1.0;
-      const double ex = ex0 * c2, ey = ey0 * c2, ez = ez0 * c2;
-      lane[ONX][i] = nx, lane[ONY][i] = ny, lane[ONZ][i] = nz;
-      lane[OHX][i] = hx, lane[OHY][i] = hy, lane[OHZ][i] = hz;
-      lane[OFX][i] = nx * fn + ex, lane[OFY][i] = ny * fn + ey, lane[OFZ][i] = nz * fn + ez;
-      lane[OA1][i] = arm1, lane[OA2][i] = arm2;
+      const PairOut o = pair_law(
+          PairIn{lane[DX][i],  lane[DY][i],  lane[DZ][i],  lane[RA][i],  lane[RB][i],  lane[VAX][i], lane[VAY][i],
+                 lane[VAZ][i], lane[VBX][i], lane[VBY][i], lane[VBZ][i], lane[WAX][i], lane[WAY][i], lane[WAZ][i],
+                 lane[WBX][i], lane[WBY][i], lane[WBZ][i], lane[IRA][i], lane[IRB][i], lane[IMA][i], lane[IMB][i],
+                 lane[NOX][i], lane[NOY][i], lane[NOZ][i], lane[HX][i],  lane[HY][i],  lane[HZ][i]},
+          law_k);
+      lane[ONX][i] = o.nx, lane[ONY][i] = o.ny, lane[ONZ][i] = o.nz;
+      lane[OHX][i] = o.hx, lane[OHY][i] = o.hy, lane[OHZ][i] = o.hz;
+      lane[OFX][i] = o.fx, lane[OFY][i] = o.fy, lane[OFZ][i] = o.fz;
+      lane[OA1][i] = o.arm1, lane[OA2][i] = o.arm2;
     }
     for (int i = 0; i < cnt; ++i) {
       const double nx = lane[ONX][i], ny = lane[ONY][i], nz = lane[ONZ][i];
