@@ -185,6 +185,22 @@ TEST(Threads, OneAndTwoThreadsGiveBitwiseIdenticalResults) {
   EXPECT_EQ(differing_balls(one, two), 0u);
 }
 
+// Three threads: the force pass cuts the balls into three ranges of equal work (not of equal numbers
+// of balls, and not at block boundaries of the one-thread run) and shares the wall rows out three
+// ways; still the same bits as one thread.
+TEST(Threads, ThreeThreadsGiveTheSameBitsAsOne) {
+  auto run = [](int threads) {
+    omp_set_num_threads(threads);
+    Simulation sim = wet_box_4000();
+    sim.cycle(60);
+    return std::make_pair(sim.balls.position, sim.balls.spin);
+  };
+  const auto one = run(1), three = run(3);
+  omp_set_num_threads(omp_get_num_procs());
+  ASSERT_EQ(one.first.size(), three.first.size());
+  EXPECT_EQ(differing_balls(one, three), 0u);
+}
+
 // A thread count that changes from step to step (engine/thread_budget.hpp, as a study's cases share
 // the cores) gives the same bits as one thread throughout.
 TEST(ThreadBudget, ACountThatChangesWhileItRunsGivesTheSameResults) {
