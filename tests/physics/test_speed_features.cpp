@@ -171,16 +171,19 @@ std::size_t differing_balls(const std::pair<std::vector<Vec3>, std::vector<Vec3>
   return differ;
 }
 
+// Positions and spins of wet_box_4000() after `steps` cycles on `threads` OpenMP threads (the count
+// is put back to the number of cores afterwards).
+std::pair<std::vector<Vec3>, std::vector<Vec3>> wet_box_after(int threads, int steps) {
+  omp_set_num_threads(threads);
+  Simulation sim = wet_box_4000();
+  sim.cycle(steps);
+  omp_set_num_threads(omp_get_num_procs());
+  return {sim.balls.position, sim.balls.spin};
+}
+
 // Bitwise identical positions after N steps for 1 and 2 threads (issue #4 acceptance).
 TEST(Threads, OneAndTwoThreadsGiveBitwiseIdenticalResults) {
-  auto run = [](int threads) {
-    omp_set_num_threads(threads);
-    Simulation sim = wet_box_4000();
-    sim.cycle(150);
-    return std::make_pair(sim.balls.position, sim.balls.spin);
-  };
-  const auto one = run(1), two = run(2);
-  omp_set_num_threads(omp_get_num_procs());
+  const auto one = wet_box_after(1, 150), two = wet_box_after(2, 150);
   ASSERT_EQ(one.first.size(), two.first.size());
   EXPECT_EQ(differing_balls(one, two), 0u);
 }
@@ -189,14 +192,7 @@ TEST(Threads, OneAndTwoThreadsGiveBitwiseIdenticalResults) {
 // of balls, and not at block boundaries of the one-thread run) and shares the wall rows out three
 // ways; still the same bits as one thread.
 TEST(Threads, ThreeThreadsGiveTheSameBitsAsOne) {
-  auto run = [](int threads) {
-    omp_set_num_threads(threads);
-    Simulation sim = wet_box_4000();
-    sim.cycle(60);
-    return std::make_pair(sim.balls.position, sim.balls.spin);
-  };
-  const auto one = run(1), three = run(3);
-  omp_set_num_threads(omp_get_num_procs());
+  const auto one = wet_box_after(1, 60), three = wet_box_after(3, 60);
   ASSERT_EQ(one.first.size(), three.first.size());
   EXPECT_EQ(differing_balls(one, three), 0u);
 }
