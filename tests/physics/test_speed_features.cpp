@@ -197,6 +197,54 @@ TEST(Threads, ThreeThreadsGiveTheSameBitsAsOne) {
   EXPECT_EQ(differing_balls(one, three), 0u);
 }
 
+// The contacts' reported columns (gap, F_n, F^m, |F*_s|, active) are written on the last cycle of a
+// cycle() call and on every cycle while an observer is registered, and skipped by the batched
+// ball-ball contacts in between (Simulation::cycle). With a fixed time step (no stiffness sums read
+// them), a run with no observer must end with the same columns and the same bits as one with an
+// observer, and the observer must see each cycle's own results.
+TEST(ContactResults, WrittenOnTheLastCycleAndForObservers) {
+  auto make = [] {
+    Simulation sim = random_box(800, 21);
+    sim.settings.gravity = {0, 0, -9.81};
+    sim.settings.auto_timestep = false;
+    sim.settings.timestep = 1e-6;
+    sim.make_wet(20e3, 0.3e-3);  // some bridges: F^m reported
+    return sim;
+  };
+  // Σ F_n + Σ F^m + Σ |F*_s| + Σ gap over active contacts: one number per cycle for the observer.
+  auto summary = [](const Simulation& s) {
+    double sum = 0.0;
+    for (std::size_t c = 0; c < s.contacts.size(); ++c)
+      if (s.contacts.active[c])
+        sum += s.contacts.normal_force[c] + s.contacts.moisture_force[c] + s.contacts.trial_shear[c] + s.contacts.gap[c];
+    return sum;
+  };
+  constexpr int kSteps = 120;
+  Simulation quiet = make(), watched = make(), single = make();
+  std::vector<double> seen;
+  watched.observers.push_back([&](const Simulation& s) { seen.push_back(summary(s)); });
+  quiet.cycle(kSteps);
+  watched.cycle(kSteps);
+  ASSERT_GT(quiet.batched_rows(), 100);  // the batched path ran
+  EXPECT_EQ(quiet.balls.position, watched.balls.position);
+  EXPECT_EQ(quiet.balls.spin, watched.balls.spin);
+  EXPECT_EQ(quiet.contacts.gap, watched.contacts.gap);
+  EXPECT_EQ(quiet.contacts.normal_force, watched.contacts.normal_force);
+  EXPECT_EQ(quiet.contacts.moisture_force, watched.contacts.moisture_force);
+  EXPECT_EQ(quiet.contacts.trial_shear, watched.contacts.trial_shear);
+  EXPECT_EQ(quiet.contacts.active, watched.contacts.active);
+  // One cycle per call: every cycle is a last one, so its results are its own.
+  ASSERT_EQ(seen.size(), static_cast<std::size_t>(kSteps));
+  std::size_t wet = 0, differ = 0;
+  for (int k = 0; k < kSteps; ++k) {
+    single.cycle(1);
+    differ += !(summary(single) == seen[k]);
+  }
+  for (std::size_t c = 0; c < single.contacts.size(); ++c) wet += single.contacts.moisture_force[c] < 0.0;
+  EXPECT_GT(wet, 0u);
+  EXPECT_EQ(differ, 0u);
+}
+
 // A thread count that changes from step to step (engine/thread_budget.hpp, as a study's cases share
 // the cores) gives the same bits as one thread throughout.
 TEST(ThreadBudget, ACountThatChangesWhileItRunsGivesTheSameResults) {

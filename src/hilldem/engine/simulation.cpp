@@ -18,13 +18,13 @@
 namespace hilldem {
 
 void Simulation::cycle(std::int64_t n) {
-  for (std::int64_t k = 0; k < n; ++k) step_once();
+  for (std::int64_t k = 0; k < n; ++k) step_once(k + 1 == n);
 }
 
 std::int64_t Simulation::solve(double ratio, std::int64_t max_steps) {
   // At least one cycle: forces may be stale (make_wet changes them only on the next cycle, §2.7).
   for (std::int64_t k = 1; k <= max_steps; ++k) {
-    step_once();
+    step_once(true);  // the ratio reads the contact results
     if (mean_unbalanced_ratio() <= ratio) return k;
   }
   return -1;
@@ -32,6 +32,7 @@ std::int64_t Simulation::solve(double ratio, std::int64_t max_steps) {
 
 void Simulation::update_forces() {
   rebuild_if_needed();
+  write_results_ = true;
   force_pass(0.0);
   forces_ready_ = true;
 }
@@ -50,7 +51,9 @@ double Simulation::skin() const {
   return 0.1 * 2.0 * sum / static_cast<double>(balls.size());
 }
 
-void Simulation::step_once() {
+void Simulation::step_once(bool last) {
+  // The reported results of ball-ball contacts only when someone may read them (see cycle()).
+  write_results_ = last || !observers.empty() || !controllers.empty();
   apply_thread_budget();  // when several simulations share the cores (engine/thread_budget.hpp)
   if (!forces_ready_) update_forces();
   const double dt = next_timestep();
@@ -405,11 +408,12 @@ Simulation::RowShare Simulation::force_row(std::size_t c, double dt) {
   if (settings.track_shear_displacement)
     contacts.shear_disp[c] = out.active ? rotation.rotate(contacts.shear_disp[c]) + kin.shear_rate() * dt : Vec3{};
   RowShare share;
-  store_row(c, out, want_stiffness, share);
+  store_row(c, out, want_stiffness, true, share);
   return share;
 }
 
-HILLDEM_INLINE void Simulation::store_row(std::size_t c, const RowOutcome& out, bool want_stiffness, RowShare& share) {
+HILLDEM_INLINE void Simulation::store_row(std::size_t c, const RowOutcome& out, bool want_stiffness, bool reported,
+                                         RowShare& share) {
   // Deleted when inactive beyond the proximity distance (a wet contact stays active: spec §2.5).
   if (!out.active && out.gap > settings.proximity) {
     contacts.remove(c);  // (moisture back to dry)
@@ -430,14 +434,18 @@ HILLDEM_INLINE void Simulation::store_row(std::size_t c, const RowOutcome& out, 
   share.moment = torque * -out.arm1;
   share.ok = std::isfinite(out.force.x + out.force.y + out.force.z);
   share_moment_[c] = torque * -out.arm2;
-  // Only the columns the cycle needs (memory traffic): F_s = F_c − (F_n + F^m) n̂ is derived.
+  // Only the columns the cycle needs (memory traffic): F_s = F_c − (F_n + F^m) n̂ is derived. The
+  // history and F_c (which collect_forces reads) always; the columns only reports read when
+  // `reported`; gap and the active flag also when the stiffness sums read them.
   contacts.shear_state[c] = out.shear;
   contacts.normal[c] = out.normal;
-  contacts.gap[c] = out.gap;
   contacts.force[c] = out.force;
-  contacts.normal_force[c] = out.normal_force;
-  contacts.moisture_force[c] = out.moisture_force;
-  contacts.trial_shear[c] = out.trial_shear;
+  if (reported || want_stiffness) contacts.gap[c] = out.gap;
+  if (reported) {
+    contacts.normal_force[c] = out.normal_force;
+    contacts.moisture_force[c] = out.moisture_force;
+    contacts.trial_shear[c] = out.trial_shear;
+  }
   if (want_stiffness) {  // only the time-step estimate and density scaling read them
     contacts.k_tran[c] = out.k_tran;
     contacts.k_shear[c] = out.k_shear;
@@ -445,7 +453,7 @@ HILLDEM_INLINE void Simulation::store_row(std::size_t c, const RowOutcome& out, 
   // Byte-sized columns last: a char store may alias anything, so the compiler reloads every
   // column pointer after one.
   contacts.moisture[c] = out.moisture;
-  contacts.active[c] = out.active;
+  if (reported || want_stiffness) contacts.active[c] = out.active;
 }
 
 void Simulation::force_block(std::size_t a0, std::size_t a1, double dt, BlockScratch& scratch, std::size_t& bad_row,
@@ -456,6 +464,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, double dt, BlockScr
   const double proximity = settings.proximity;
   const bool want_stiffness = settings.auto_timestep || settings.density_scaling;
   const bool batched = use_batched_kernel && !settings.track_shear_displacement;
+  const bool reported = write_results_;
   const PeriodicBox& box = settings.box;
   const BallKin* kin = ball_kin_.data();
   const ContactKey* keys = contacts.key.data();
@@ -498,7 +507,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, double dt, BlockScr
       out.moisture = batch.col(F::kRuptured)[lane] != 0.0 ? Moisture::Ruptured : contacts.moisture[c];
       out.active = batch.col(F::kActive)[lane] != 0.0;
       RowShare& share = shares[c - r0];
-      store_row(c, out, want_stiffness, share);
+      store_row(c, out, want_stiffness, reported, share);
       if (!share.ok) bad_row = std::min(bad_row, c);
     }
     batch.clear();
