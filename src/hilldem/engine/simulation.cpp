@@ -436,11 +436,12 @@ HILLDEM_INLINE void Simulation::store_row(std::size_t c, const RowOutcome& out, 
   share_moment_[c] = torque * -out.arm2;
   // Only the columns the cycle needs (memory traffic): F_s = F_c − (F_n + F^m) n̂ is derived. The
   // history and F_c (which collect_forces reads) always; the columns only reports read when
-  // `reported`; gap and the active flag also when the stiffness sums read them.
+  // `reported`; gap and the active flag also when the stiffness sums read them (and the gap when
+  // the force is not finite: the run's error message names it).
   contacts.shear_state[c] = out.shear;
   contacts.normal[c] = out.normal;
   contacts.force[c] = out.force;
-  if (reported || want_stiffness) contacts.gap[c] = out.gap;
+  if (reported || want_stiffness || !share.ok) contacts.gap[c] = out.gap;
   if (reported) {
     contacts.normal_force[c] = out.normal_force;
     contacts.moisture_force[c] = out.moisture_force;
