@@ -17,6 +17,11 @@
 
 namespace hilldem {
 
+namespace {
+// The row of a late_rows_ entry (+(r+1) for piece 2 of a ball-ball row, −(r+1) for a wall row).
+inline std::size_t late_row(std::int32_t code) { return static_cast<std::size_t>(code > 0 ? code : -code) - 1; }
+}  // namespace
+
 void Simulation::cycle(std::int64_t n) {
   for (std::int64_t k = 0; k < n; ++k) step_once(k + 1 == n);
 }
@@ -703,14 +708,13 @@ void Simulation::collect_forces() {
       for (std::uint32_t k = late_rows_start_[i]; k < late_rows_start_[i + 1]; ++k) {
         if constexpr (decltype(prefetch)::value) {
           if (k + kAhead < late_total) {
-            const std::int32_t ahead = late_rows_[k + kAhead];
-            const std::size_t r = static_cast<std::size_t>(ahead > 0 ? ahead - 1 : -ahead - 1);
+            const std::size_t r = late_row(late_rows_[k + kAhead]);
             __builtin_prefetch(force + r);
             __builtin_prefetch(moment + r);
           }
         }
         const std::int32_t code = late_rows_[k];
-        const std::size_t c = static_cast<std::size_t>(code > 0 ? code - 1 : -code - 1);
+        const std::size_t c = late_row(code);
         if (code > 0) f += force[c];
         else f -= force[c];
         m += moment[c];
@@ -720,7 +724,7 @@ void Simulation::collect_forces() {
       if (want_stiffness) {  // the second half of the stiffness sums (the order of ball_stiffness())
         double k_tran = ball_k_tran_[i], k_rot = ball_k_rot_[i];
         for (std::uint32_t k = late_rows_start_[i]; k < late_rows_start_[i + 1]; ++k)
-          add_row_stiffness(static_cast<std::size_t>(std::abs(late_rows_[k]) - 1), balls.radius[i], k_tran, k_rot);
+          add_row_stiffness(late_row(late_rows_[k]), balls.radius[i], k_tran, k_rot);
         ball_k_tran_[i] = k_tran;
         ball_k_rot_[i] = k_rot;
       }
@@ -766,7 +770,7 @@ void Simulation::ball_stiffness(std::size_t i, double& k_tran, double& k_rot) co
   if (i + 1 >= first_rows_.size()) return;  // a ball added since the last rebuild: no contacts yet
   for (std::size_t c = first_rows_[i]; c < first_rows_[i + 1]; ++c) add_row_stiffness(c, balls.radius[i], k_tran, k_rot);
   for (std::uint32_t k = late_rows_start_[i]; k < late_rows_start_[i + 1]; ++k)
-    add_row_stiffness(static_cast<std::size_t>(std::abs(late_rows_[k]) - 1), balls.radius[i], k_tran, k_rot);
+    add_row_stiffness(late_row(late_rows_[k]), balls.radius[i], k_tran, k_rot);
 }
 
 double Simulation::estimate_timestep() const {
