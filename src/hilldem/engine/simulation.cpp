@@ -18,8 +18,15 @@
 namespace hilldem {
 
 namespace {
-// The row of a late_rows_ entry (+(r+1) for piece 2 of a ball-ball row, −(r+1) for a wall row).
-inline std::size_t late_row(std::int32_t code) { return static_cast<std::size_t>(code > 0 ? code : -code) - 1; }
+// A row's terms of a ball's stiffness sums: k_tran += k̂_n + k̂_s, k_rot += k̂_s |x_c − x|² with
+// |x_c − x| = R + g/2 (the contact point is on the normal). One expression for the force pass and
+// for add_row_stiffness, so that both round (and contract into multiply-adds) alike.
+HILLDEM_INLINE void add_stiffness(double k_tran_row, double k_shear, double radius, double gap, double& k_tran,
+                                  double& k_rot) {
+  const double arm = radius + 0.5 * gap;
+  k_tran += k_tran_row;
+  k_rot += k_shear * arm * arm;
+}
 }  // namespace
 
 void Simulation::cycle(std::int64_t n) {
@@ -267,13 +274,14 @@ void Simulation::rebuild(double proximity) {
 }
 
 void Simulation::build_row_lists() {
-  // The row lists of the two halves of every per-ball sum (see first_rows_ / late_rows_), in row order.
+  // The per-ball row lists of the force sum (see first_rows_, late_rows_, wall_rows_), in row order.
   const std::size_t n = balls.size();
   const std::size_t rows = contacts.size();
-  if (rows > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
+  if (rows > static_cast<std::size_t>(std::numeric_limits<std::uint32_t>::max()))
     throw RunError("too many neighbour pairs (" + std::to_string(rows) + ") for one process");
   first_rows_.assign(n + 1, 0);
   late_rows_start_.assign(n + 1, 0);
+  wall_rows_start_.assign(n + 1, 0);
   wall_rows_.clear();
   for (std::size_t c = 0; c < rows; ++c) {
     const ContactKey& k = contacts.key[c];
@@ -281,25 +289,22 @@ void Simulation::build_row_lists() {
       ++first_rows_[k.a + 1];
       ++late_rows_start_[k.b + 1];
     } else {
-      wall_rows_.push_back(static_cast<std::uint32_t>(c));
-      ++late_rows_start_[k.a + 1];
+      wall_rows_.push_back(static_cast<std::uint32_t>(c));  // (sorted by ball: keys by kind, then a)
+      ++wall_rows_start_[k.a + 1];
     }
   }
   for (std::size_t i = 0; i < n; ++i) {
     first_rows_[i + 1] += first_rows_[i];
     late_rows_start_[i + 1] += late_rows_start_[i];
+    wall_rows_start_[i + 1] += wall_rows_start_[i];
   }
   late_rows_.assign(late_rows_start_[n], 0);
   std::vector<std::uint32_t> late_fill(late_rows_start_.begin(), late_rows_start_.end() - 1);
   for (std::size_t c = 0; c < rows; ++c) {
     const ContactKey& k = contacts.key[c];
-    const auto row = static_cast<std::int32_t>(c) + 1;
-    if (k.kind == ContactKind::BallBall) late_rows_[late_fill[k.b]++] = row;
-    else late_rows_[late_fill[k.a]++] = -row;
+    if (k.kind == ContactKind::BallBall) late_rows_[late_fill[k.b]++] = static_cast<std::uint32_t>(c);
   }
   share_moment_.assign(rows, Vec3{});
-  first_force_.assign(n, Vec3{});
-  first_moment_.assign(n, Vec3{});
   ball_k_tran_.assign(n, 0.0);
   ball_k_rot_.assign(n, 0.0);
   stiffness_ready_ = false;
@@ -424,8 +429,7 @@ HILLDEM_INLINE void Simulation::store_row(std::size_t c, const RowOutcome& out, 
     contacts.remove(c);  // (moisture back to dry)
     contacts.gap[c] = out.gap;
     contacts.normal[c] = out.normal;
-    share_moment_[c] = Vec3{};
-    share.clear_forces();
+    share.clear(want_stiffness);
     share.ok = true;
     return;
   }
@@ -437,15 +441,20 @@ HILLDEM_INLINE void Simulation::store_row(std::size_t c, const RowOutcome& out, 
   const Vec3 torque = cross(out.normal, out.force);
   share.force = -out.force;
   share.moment = torque * -out.arm1;
+  share.moment2 = torque * -out.arm2;
   share.ok = std::isfinite(out.force.x + out.force.y + out.force.z);
-  share_moment_[c] = torque * -out.arm2;
+  if (want_stiffness) {  // what add_row_stiffness reads (zero when inactive)
+    share.k_tran = out.k_tran;
+    share.k_shear = out.k_shear;
+    share.gap = out.gap;
+  }
   // Only the columns the cycle needs (memory traffic): F_s = F_c − (F_n + F^m) n̂ is derived. The
-  // history and F_c (which collect_forces reads) always; the columns only reports read when
-  // `reported`; gap and the active flag also when the stiffness sums read them (and the gap when
-  // the force is not finite: the run's error message names it).
+  // history always; F_c and the columns only reports read when `reported` (wall rows, which
+  // collect_forces reads from F_c, always are); gap and the active flag also when the stiffness
+  // sums read them (and the gap when the force is not finite: the run's error message names it).
   contacts.shear_state[c] = out.shear;
   contacts.normal[c] = out.normal;
-  contacts.force[c] = out.force;
+  if (reported) contacts.force[c] = out.force;
   if (reported || want_stiffness || !share.ok) contacts.gap[c] = out.gap;
   if (reported) {
     contacts.normal_force[c] = out.normal_force;
@@ -462,11 +471,14 @@ HILLDEM_INLINE void Simulation::store_row(std::size_t c, const RowOutcome& out, 
   if (reported || want_stiffness) contacts.active[c] = out.active;
 }
 
-void Simulation::force_block(std::size_t a0, std::size_t a1, double dt, BlockScratch& scratch, std::size_t& bad_row,
-                             std::int64_t& batched_count, bool count_contacts) {
-  // Rows of balls a0..a1-1 (ball-ball rows, contiguous). Existing hill and linear contacts go through
-  // the batches; new contacts and the shear-displacement tracking through force_row().
-  const std::size_t r0 = first_rows_[a0], r1 = first_rows_[a1];
+void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_end, double dt, BlockScratch& scratch,
+                             std::vector<CrossShare>& crossing, std::size_t& bad_row, std::int64_t& batched_count,
+                             bool count_contacts) {
+  // Rows of balls a0..a1-1 (ball-ball rows, contiguous), from the last ball down and each ball's rows
+  // from the last down. Existing hill and linear contacts go through the batches; new contacts and
+  // the shear-displacement tracking through force_row(). Each row's share is added to both balls
+  // when its result is known, in that descending row order (the order of force_pass): a batch is
+  // run before a row of the other batch or of force_row() is added, so the lanes keep the order.
   const double proximity = settings.proximity;
   const bool want_stiffness = settings.auto_timestep || settings.density_scaling;
   const bool batched = use_batched_kernel && !settings.track_shear_displacement;
@@ -474,9 +486,9 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, double dt, BlockScr
   const PeriodicBox& box = settings.box;
   const BallKin* kin = ball_kin_.data();
   const ContactKey* keys = contacts.key.data();
+  Vec3* __restrict ball_force = balls.contact_force.data();
+  Vec3* __restrict ball_moment = balls.contact_moment.data();
   constexpr std::size_t kPrefetchRows = 16;
-  std::vector<RowShare>& shares = scratch.shares;
-  if (shares.size() < r1 - r0) shares.resize(r1 - r0);  // every row's share is written below
   using F = ContactBatch;
   ContactBatch& hill = scratch.hill;
   ContactBatch& linear = scratch.linear;
@@ -491,7 +503,22 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, double dt, BlockScr
     return Vec3{batch.col(f)[lane], batch.col(static_cast<F::Field>(f + 1))[lane],
                 batch.col(static_cast<F::Field>(f + 2))[lane]};
   };
-  // The law of the gathered lanes, and their results into the rows.
+  // Row c's share into its two balls (b beyond this thread's range: into `crossing`, see force_pass).
+  auto add_share = [&](std::size_t c, const RowShare& s) __attribute__((always_inline)) {
+    if (!s.ok) bad_row = std::min(bad_row, c);
+    const std::size_t a = keys[c].a, b = keys[c].b;
+    ball_force[a] += s.force;
+    ball_moment[a] += s.moment;
+    if (want_stiffness) add_stiffness(s.k_tran, s.k_shear, kin[a].radius, s.gap, ball_k_tran_[a], ball_k_rot_[a]);
+    if (b < range_end) {
+      ball_force[b] -= s.force;  // (+F_c, bit for bit)
+      ball_moment[b] += s.moment2;
+      if (want_stiffness) add_stiffness(s.k_tran, s.k_shear, kin[b].radius, s.gap, ball_k_tran_[b], ball_k_rot_[b]);
+    } else {
+      crossing.push_back({static_cast<std::uint32_t>(b), -s.force, s.moment2, s.k_tran, s.k_shear, s.gap});
+    }
+  };
+  // The law of the gathered lanes, and their results into the rows and the balls.
   auto flush = [&](ContactBatch& batch) {
     if (&batch == &hill) hill_batch_forces(batch, dt, want_stiffness);
     else linear_batch_forces(batch, dt, want_stiffness);
@@ -512,21 +539,30 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, double dt, BlockScr
       out.k_shear = batch.col(F::kKshear)[lane];
       out.moisture = batch.col(F::kRuptured)[lane] != 0.0 ? Moisture::Ruptured : contacts.moisture[c];
       out.active = batch.col(F::kActive)[lane] != 0.0;
-      RowShare& share = shares[c - r0];
+      RowShare share;
       store_row(c, out, want_stiffness, reported, share);
-      if (!share.ok) bad_row = std::min(bad_row, c);
+      add_share(c, share);
     }
     batch.clear();
   };
-  for (std::size_t a = a0; a < a1; ++a) {
+  for (std::size_t a = a1; a-- > a0;) {
+    // Ball a's sums start here: its own rows come first in its order, and rows (x, a) with x < a
+    // come later.
+    ball_force[a] = Vec3{};
+    ball_moment[a] = Vec3{};
+    if (want_stiffness) ball_k_tran_[a] = ball_k_rot_[a] = 0.0;
     const BallKin& ka = kin[a];
-    for (std::size_t c = first_rows_[a]; c < first_rows_[a + 1]; ++c) {
-      if (c + kPrefetchRows < r1) {
-        // The ball record of a neighbour some rows on: the neighbours in the layer above a ball are a
-        // whole layer away in memory, and the hardware prefetcher misses them (perf annotate).
-        const char* ahead = reinterpret_cast<const char*>(kin + keys[c + kPrefetchRows].b);
+    for (std::size_t c = first_rows_[a + 1]; c-- > first_rows_[a];) {
+      if (c >= kPrefetchRows) {
+        // The ball record of a neighbour some rows on, and its force sums: the neighbours in the layer
+        // above a ball are a whole layer away in memory, and the hardware prefetcher misses them
+        // (perf annotate).
+        const std::size_t ahead_ball = keys[c - kPrefetchRows].b;
+        const char* ahead = reinterpret_cast<const char*>(kin + ahead_ball);
         __builtin_prefetch(ahead);
         __builtin_prefetch(ahead + 64);
+        __builtin_prefetch(ball_force + ahead_ball, 1);
+        __builtin_prefetch(ball_moment + ahead_ball, 1);
       }
       const std::size_t b = keys[c].b;
       const BallKin& kb = kin[b];
@@ -536,18 +572,18 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, double dt, BlockScr
       const bool exists = contacts.exists[c];
       if (!exists && batched) {  // a neighbour pair: a contact only once within proximity (as force_row)
         const double reach = ka.radius + kb.radius + proximity;
-        if (norm2(d) > reach * reach) {
-          shares[c - r0].clear_forces();
-          continue;
-        }
+        if (norm2(d) > reach * reach) continue;  // gives nothing to either ball
       }
       if (!batched || !exists) {
-        shares[c - r0] = force_row(c, dt);
-        if (!shares[c - r0].ok) bad_row = std::min(bad_row, c);
+        if (hill.size() > 0) flush(hill);
+        if (linear.size() > 0) flush(linear);
+        add_share(c, force_row(c, dt));
         continue;
       }
       const bool is_hill = contacts.model[c] == ModelKind::Hill;
       ContactBatch& batch = is_hill ? hill : linear;
+      ContactBatch& other = is_hill ? linear : hill;
+      if (other.size() > 0) flush(other);
       if (batch.full()) flush(batch);
       const std::size_t lane = batch.add(static_cast<std::uint32_t>(c));
       put3(batch, F::kDx, lane, d);
@@ -577,29 +613,12 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, double dt, BlockScr
   }
   if (hill.size() > 0) flush(hill);
   if (linear.size() > 0) flush(linear);
-  if (count_contacts)  // for the next pass's split_work (a separate loop: the sum below stays as it was)
+  if (count_contacts)  // for the next pass's split_work
     for (std::size_t a = a0; a < a1; ++a) {
       std::uint32_t count = 0;
       for (std::size_t c = first_rows_[a]; c < first_rows_[a + 1]; ++c) count += contacts.exists[c];
       ball_contacts_[a] = count;
     }
-  // Ball a's half of the force sum, its rows in row order; and of its stiffness sums when the time
-  // step or density scaling needs them.
-  for (std::size_t a = a0; a < a1; ++a) {
-    Vec3 f, m;
-    for (std::size_t c = first_rows_[a]; c < first_rows_[a + 1]; ++c) {
-      f += shares[c - r0].force;
-      m += shares[c - r0].moment;
-    }
-    first_force_[a] = f;
-    first_moment_[a] = m;
-    if (want_stiffness) {
-      double k_tran = 0.0, k_rot = 0.0;
-      for (std::size_t c = first_rows_[a]; c < first_rows_[a + 1]; ++c) add_row_stiffness(c, kin[a].radius, k_tran, k_rot);
-      ball_k_tran_[a] = k_tran;
-      ball_k_rot_[a] = k_rot;
-    }
-  }
 }
 
 void Simulation::split_work(int threads) {
@@ -630,9 +649,11 @@ void Simulation::force_pass(double dt) {
   const std::size_t n = balls.size();
   // Blocks of balls, each with its own rows (ball-ball rows are sorted by their first ball); each
   // row writes only its own columns. Each thread takes a range of balls of equal work
-  // (split_work) in blocks of balls_per_block from its start: results depend neither on the
-  // blocks (ContactBatch::pad_lanes) nor, then, on the thread count. The first failing row is found
-  // by a min-reduction, so the outcome does not depend on the thread count.
+  // (split_work) in blocks of balls_per_block from its start, and runs the blocks from the last
+  // down. Every ball's force is summed in one order whatever the ranges: its ball-ball rows in
+  // descending row order, then its wall rows (first_rows_, force_block, collect_forces). So results
+  // depend neither on the blocks (ContactBatch::pad_lanes) nor on the thread count. The first
+  // failing row is found by a min-reduction, so the outcome does not depend on the thread count.
   const std::size_t block = std::max<std::size_t>(1, balls_per_block);
   std::size_t bad_row = rows;
   std::int64_t batched = 0;
@@ -640,6 +661,8 @@ void Simulation::force_pass(double dt) {
   ball_kin_.resize(n);
   const std::size_t wall_rows = wall_rows_.size();
   ball_contacts_.resize(n);
+  balls.contact_force.resize(n);
+  balls.contact_moment.resize(n);
 #pragma omp parallel reduction(min : bad_row) reduction(+ : batched) if (n > kParallelMin)
   {
     // What the pair loop reads of each ball, in one record (two cache lines): one memory stream per
@@ -658,19 +681,29 @@ void Simulation::force_pass(double dt) {
     }
     auto scratch = std::make_unique<BlockScratch>();  // ≈ 60 kB: on the heap, not the thread's stack
 #pragma omp single
-    split_work(omp_get_num_threads());
+    {
+      split_work(omp_get_num_threads());
+      crossing_.resize(static_cast<std::size_t>(omp_get_num_threads()));
+    }
     const auto t = static_cast<std::size_t>(omp_get_thread_num());
     const std::size_t first = work_start_[t], last = work_start_[t + 1];
+    std::vector<CrossShare>& crossing = crossing_[t];
+    crossing.clear();
     // One thread needs no split, nor the counts it is made from (3 % of a step in cache).
     const bool count_contacts = omp_get_num_threads() > 1;
-    for (std::size_t a = first; a < last; a += block)
-      force_block(a, std::min(last, a + block), dt, *scratch, bad_row, batched, count_contacts);
+    if (last > first)
+      for (std::size_t a = first + (last - first - 1) / block * block;; a -= block) {
+        force_block(a, std::min(last, a + block), last, dt, *scratch, crossing, bad_row, batched, count_contacts);
+        if (a == first) break;
+      }
     // The wall rows (row by row), shared out the same way whatever their number: no thread waits
     // for another to do them alone.
 #pragma omp for schedule(static)
     for (std::size_t k = 0; k < wall_rows; ++k) {
       const std::size_t c = wall_rows_[k];
-      if (!force_row(c, dt).ok) bad_row = std::min(bad_row, c);
+      const RowShare share = force_row(c, dt);
+      share_moment_[c] = share.moment2;
+      if (!share.ok) bad_row = std::min(bad_row, c);
     }
   }
   batched_rows_ = batched;
@@ -688,50 +721,26 @@ void Simulation::force_pass(double dt) {
 }
 
 void Simulation::collect_forces() {
-  // Each ball adds, to the pair loop's half, its late rows in row order: the same result for any
-  // number of threads. Rows that are not active contacts hold zero force and moment.
-  const std::size_t n = balls.size();
-  const Vec3* force = contacts.force.data();
-  const Vec3* moment = share_moment_.data();
-  // The rows a ball collects lie all over the rows of its neighbours: beyond the caches (a bed of
-  // 100,800 balls) asking for them 12 entries ahead gave 1.02 × a step (medians of four series of
-  // side-by-side runs, 1.022-1.026; 1.016 × on two threads); in the caches (lab tests, 3,576 balls) a
-  // run-time test inside the loop cost 0.95-0.97 ×. So two loops, the first only when the two columns
-  // read here pass 2 MB (≈ 44,000 rows; in cache: 1.002 ×). The prefetch changes no result.
-  const std::size_t late_total = late_rows_.size();
+  // The end of every ball's force sum (the order of force_pass): the shares of rows whose second
+  // ball lay beyond the range of the thread that ran them, in descending row order (the threads'
+  // ranges from the last down, each thread's list in the order it was made), then each ball's wall
+  // rows in row order. Rows that are not active contacts hold zero force and moment.
   const bool want_stiffness = settings.auto_timestep || settings.density_scaling;
-  auto collect = [&](auto prefetch) {
-    constexpr std::size_t kAhead = 12;
-#pragma omp parallel for schedule(static) if (n > kParallelMin)
-    for (std::size_t i = 0; i < n; ++i) {
-      Vec3 f = first_force_[i], m = first_moment_[i];
-      for (std::uint32_t k = late_rows_start_[i]; k < late_rows_start_[i + 1]; ++k) {
-        if constexpr (decltype(prefetch)::value) {
-          if (k + kAhead < late_total) {
-            const std::size_t r = late_row(late_rows_[k + kAhead]);
-            __builtin_prefetch(force + r);
-            __builtin_prefetch(moment + r);
-          }
-        }
-        const std::int32_t code = late_rows_[k];
-        const std::size_t c = late_row(code);
-        if (code > 0) f += force[c];
-        else f -= force[c];
-        m += moment[c];
-      }
-      balls.contact_force[i] = f;
-      balls.contact_moment[i] = m;
-      if (want_stiffness) {  // the second half of the stiffness sums (the order of ball_stiffness())
-        double k_tran = ball_k_tran_[i], k_rot = ball_k_rot_[i];
-        for (std::uint32_t k = late_rows_start_[i]; k < late_rows_start_[i + 1]; ++k)
-          add_row_stiffness(late_row(late_rows_[k]), balls.radius[i], k_tran, k_rot);
-        ball_k_tran_[i] = k_tran;
-        ball_k_rot_[i] = k_rot;
-      }
+  Vec3* __restrict ball_force = balls.contact_force.data();
+  Vec3* __restrict ball_moment = balls.contact_moment.data();
+  for (std::size_t t = crossing_.size(); t-- > 0;)
+    for (const CrossShare& s : crossing_[t]) {
+      ball_force[s.b] += s.force;
+      ball_moment[s.b] += s.moment;
+      if (want_stiffness)
+        add_stiffness(s.k_tran, s.k_shear, balls.radius[s.b], s.gap, ball_k_tran_[s.b], ball_k_rot_[s.b]);
     }
-  };
-  if (late_total * 2 * sizeof(Vec3) > (std::size_t{2} << 20)) collect(std::true_type{});
-  else collect(std::false_type{});
+  for (std::uint32_t c : wall_rows_) {
+    const std::size_t i = contacts.key[c].a;
+    ball_force[i] -= contacts.force[c];
+    ball_moment[i] += share_moment_[c];
+    if (want_stiffness) add_row_stiffness(c, balls.radius[i], ball_k_tran_[i], ball_k_rot_[i]);
+  }
   stiffness_ready_ = want_stiffness;
   for (Wall& w : walls.walls) {
     w.force = w.moment = Vec3{};
@@ -753,9 +762,7 @@ void Simulation::collect_forces() {
 
 void Simulation::add_row_stiffness(std::size_t c, double radius, double& k_tran, double& k_rot) const {
   if (!contacts.active[c]) return;
-  const double arm = radius + 0.5 * contacts.gap[c];  // |x_c − x| (the contact point is on the normal)
-  k_tran += contacts.k_tran[c];
-  k_rot += contacts.k_shear[c] * arm * arm;
+  add_stiffness(contacts.k_tran[c], contacts.k_shear[c], radius, contacts.gap[c], k_tran, k_rot);
 }
 
 void Simulation::ball_stiffness(std::size_t i, double& k_tran, double& k_rot) const {
@@ -764,13 +771,16 @@ void Simulation::ball_stiffness(std::size_t i, double& k_tran, double& k_rot) co
     k_rot = ball_k_rot_[i];
     return;
   }
-  // The same sums from the rows, in the same order (rows as first ball, then the late rows), so the
-  // result does not depend on which way it was computed (a resumed run takes this way first).
+  // The same sums from the rows, in the same order (force_pass: the ball-ball rows in descending
+  // row order, its own rows then those where it is piece 2; then its wall rows), so the result does
+  // not depend on which way it was computed (a resumed run takes this way first).
   k_tran = k_rot = 0.0;
   if (i + 1 >= first_rows_.size()) return;  // a ball added since the last rebuild: no contacts yet
-  for (std::size_t c = first_rows_[i]; c < first_rows_[i + 1]; ++c) add_row_stiffness(c, balls.radius[i], k_tran, k_rot);
-  for (std::uint32_t k = late_rows_start_[i]; k < late_rows_start_[i + 1]; ++k)
-    add_row_stiffness(late_row(late_rows_[k]), balls.radius[i], k_tran, k_rot);
+  for (std::size_t c = first_rows_[i + 1]; c-- > first_rows_[i];) add_row_stiffness(c, balls.radius[i], k_tran, k_rot);
+  for (std::uint32_t k = late_rows_start_[i + 1]; k-- > late_rows_start_[i];)
+    add_row_stiffness(late_rows_[k], balls.radius[i], k_tran, k_rot);
+  for (std::uint32_t k = wall_rows_start_[i]; k < wall_rows_start_[i + 1]; ++k)
+    add_row_stiffness(wall_rows_[k], balls.radius[i], k_tran, k_rot);
 }
 
 double Simulation::estimate_timestep() const {

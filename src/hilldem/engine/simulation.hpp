@@ -5,9 +5,9 @@
 //      proximity + skin) is rebuilt only when something moved more than half the skin, history
 //      kept by a sorted merge; contacts are created and deleted on it by proximity,
 //   4. force-displacement law of every contact -> forces at t+Δt (existing ball-ball contacts in
-//      vectorised batches, engine/contact_batch.hpp), summed per body in a fixed order (first-ball
-//      rows in the pair loop, then per-ball lists of the rest), so results are bitwise identical for
-//      any number of threads.
+//      vectorised batches, engine/contact_batch.hpp), summed per ball in one fixed order (its
+//      ball-ball rows in descending row order, then its wall rows), so results are bitwise
+//      identical for any number of threads.
 // Lab-test drivers and the scenario runner use only this public API.
 #pragma once
 
@@ -164,21 +164,38 @@ class Simulation {
   void force_pass(double dt);
   // work_start_[t]: the first ball of thread t's range in the force pass, cut at equal work.
   void split_work(int threads);
-  // What a row gives the ball it is summed into inside the pair loop (piece 1 of a ball-ball row).
+  // What a row gives its two bodies (zero when the row is not an active contact).
   struct RowShare {
-    Vec3 force;   // −F_c [N] (zero when the row is not an active contact)
-    Vec3 moment;  // −(R_1 + g/2) n̂_c × F_c [N m]
+    Vec3 force;    // on piece 1: −F_c [N] (piece 2 gets F_c = −force)
+    Vec3 moment;   // on piece 1: −(R_1 + g/2) n̂_c × F_c [N m]
+    Vec3 moment2;  // on piece 2 (or, for a wall row, on its ball): −(R_2 + g/2) n̂_c × F_c [N m]
+    // What the row adds to the stiffness sums (when the time step needs them): k̂_n + k̂_s, k̂_s
+    // [N/m] (zero when not an active contact) and the gap [m] (add_stiffness).
+    double k_tran = 0.0, k_shear = 0.0, gap = 0.0;
     bool ok = true;  // false on a non-finite force
-    // Zero force and moment, by two stores: `force = moment = Vec3{}` reloads the moment just stored
-    // and stalls store forwarding (40 % of the pair loop's samples in cache; 1.05 × in cache).
-    void clear_forces() {
+    // Zero the forces and moments, and the stiffness terms when they are read, field by field:
+    // `force = moment = Vec3{}` reloads the moment just stored and stalls store forwarding (40 % of
+    // the pair loop's samples in cache; 1.05 × in cache).
+    void clear(bool stiffness) {
       force = Vec3{};
       moment = Vec3{};
+      moment2 = Vec3{};
+      if (stiffness) {
+        k_tran = 0.0;
+        k_shear = 0.0;
+        gap = 0.0;
+      }
     }
   };
-  // The force-displacement law of one row (any model and kind). Writes the row's columns and, in
-  // share_moment_, the moment on the body that collects the row after the pass (piece 2 of a ball-ball
-  // row, the ball of a ball-wall row).
+  // A ball-ball row whose second ball lies beyond the range of the thread that ran it: its share of
+  // that ball, added after the parallel pass (see force_pass).
+  struct CrossShare {
+    std::uint32_t b;
+    Vec3 force, moment;
+    double k_tran, k_shear, gap;
+  };
+  // The force-displacement law of one row (any model and kind). Writes the row's columns; the
+  // returned share holds what both bodies get.
   RowShare force_row(std::size_t c, double dt);
   // A row's result, from either law path (row by row or batched).
   struct RowOutcome {
@@ -199,14 +216,15 @@ class Simulation {
   // What one thread reuses from block to block.
   struct BlockScratch {
     ContactBatch hill, linear;
-    std::vector<RowShare> shares;
   };
-  // The rows of balls a0..a1-1 (ball-ball), with their half of the force sum; bad_row: the lowest
-  // row with a non-finite force; batched: + the rows that went through a batch.
+  // The rows of balls a0..a1-1 (ball-ball), summed into both balls (see force_pass for the order);
+  // a second ball at or beyond range_end (outside this thread's range) gets its share in `crossing`.
+  // bad_row: the lowest row with a non-finite force; batched: + the rows that went through a batch.
   // count_contacts: also count each ball's contacts for the next pass's split_work.
-  void force_block(std::size_t a0, std::size_t a1, double dt, BlockScratch& scratch, std::size_t& bad_row,
-                   std::int64_t& batched, bool count_contacts);
-  // Second half of the force sum: each ball adds the rows it did not sum in the pair loop.
+  void force_block(std::size_t a0, std::size_t a1, std::size_t range_end, double dt, BlockScratch& scratch,
+                   std::vector<CrossShare>& crossing, std::size_t& bad_row, std::int64_t& batched,
+                   bool count_contacts);
+  // The end of the force sum: the crossing shares, then each ball's wall rows; the walls' sums.
   void collect_forces();
   void compute_mapping(ContactStore& store, std::size_t c) const;
   // Row c becomes a contact (created by proximity) with its rule's properties.
@@ -227,19 +245,25 @@ class Simulation {
   std::int64_t rebuilds_ = 0;
   std::vector<Vec3> position_at_build_;
   double wall_travel_ = 0.0;                 // bound on any wall point's motion since the rebuild [m]
-  std::vector<std::uint32_t> wall_rows_;     // rows of ball-wall pairs
-  // The force sum in two halves (each in a fixed order, so any thread count gives the same bits):
-  // the pair loop runs over balls a, through a's ball-ball rows (rows first_rows_[a]..[a+1]: keys
-  // are sorted by kind, then a), and adds each row's share to a; then each ball adds the rows of
-  // late_rows_ (CSR, row r as +(r+1) when it is piece 2 of a ball-ball row, −(r+1) for its wall
-  // rows), from F_c and share_moment_ only: one or two cache lines per entry.
+  std::vector<std::uint32_t> wall_rows_;     // rows of ball-wall pairs (in row order: by ball)
+  // The force sum, in one order for any thread count (so any thread count gives the same bits): a
+  // ball's ball-ball rows in descending row order, then its wall rows in row order. The pair loop
+  // runs over the balls a of a thread's range from its last ball down, through a's ball-ball rows
+  // (rows first_rows_[a]..[a+1]: keys are sorted by kind, then a, then b > a) from the last down,
+  // and adds each row's share to a and to b: b's own rows came before (b > a), and every row (x, b)
+  // with x < a comes after. A row whose b lies beyond the thread's range leaves b's share in
+  // crossing_, added after the pass in descending row order: those rows (x below the range of b's
+  // thread) come last in b's order. Then the wall rows, from F_c and share_moment_.
   std::vector<std::uint32_t> first_rows_;
+  // Per ball, the ball-ball rows where it is piece 2 (in row order; the same sums from the rows
+  // when the pass's sums are not at hand, ball_stiffness), and its wall rows in wall_rows_.
   std::vector<std::uint32_t> late_rows_start_;
-  std::vector<std::int32_t> late_rows_;
-  std::vector<Vec3> share_moment_;           // [N m] moment of row r on its late-collecting body
-  std::vector<Vec3> first_force_, first_moment_;  // per ball, the pair loop's half [N], [N m]
-  // Per ball, Σ(k̂_n + k̂_s) [N/m] and Σ k̂_s |x_c − x|² [N m] of the last force pass (in the same two
-  // halves as the forces), valid while stiffness_ready_.
+  std::vector<std::uint32_t> late_rows_;
+  std::vector<std::uint32_t> wall_rows_start_;
+  std::vector<Vec3> share_moment_;           // [N m] moment of wall row r on its ball
+  std::vector<std::vector<CrossShare>> crossing_;  // per thread of the last force pass
+  // Per ball, Σ(k̂_n + k̂_s) [N/m] and Σ k̂_s |x_c − x|² [N m] of the last force pass (in the order of
+  // the forces), valid while stiffness_ready_.
   std::vector<double> ball_k_tran_, ball_k_rot_;
   bool stiffness_ready_ = false;
   struct alignas(64) BallKin {
