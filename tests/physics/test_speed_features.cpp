@@ -197,7 +197,51 @@ TEST(Threads, ThreeThreadsGiveTheSameBitsAsOne) {
   EXPECT_EQ(differing_balls(one, three), 0u);
 }
 
-// The contacts' reported columns (gap, F_n, F^m, |F*_s|, active) are written on the last cycle of a
+// Ball-ball contacts of both models in one bed: every second ball is "hard", and pairs of hard balls
+// get the linear model, all others the hill model; contacts exist from 3 mm apart, so most balls
+// have rows of both models. The force pass runs a batch before a row of the other model joins the
+// sums (force_block), so each ball's sums keep their order: 1, 2 and 3 threads and any block size
+// give the same bits in the contact forces and moments on the balls themselves. (Without that rule
+// the sums of 8 balls differ between blocks of 1 and of 128.)
+std::pair<std::vector<Vec3>, std::vector<Vec3>> mixed_box_forces(int threads, int steps, std::size_t block) {
+  omp_set_num_threads(threads);
+  Simulation sim = random_box(4000, 21, true, 0.1);
+  const std::uint64_t hard = sim.groups.bit("hard");
+  for (std::size_t i = 0; i < sim.balls.size(); i += 2) sim.balls.groups[i] |= hard;
+  ModelRule linear;
+  linear.name = "hard-hard";
+  linear.kind = ContactKind::BallBall;
+  linear.groups1 = linear.groups2 = hard;
+  linear.model = ModelKind::Linear;
+  linear.linear = {100e6, 1.5, 0.3};
+  sim.table.rules.insert(sim.table.rules.begin(), linear);
+  sim.settings.gravity = {0, 0, -9.81};
+  sim.settings.local_damping = 0.3;
+  sim.settings.auto_timestep = true;
+  sim.settings.proximity = 3e-3;
+  sim.balls_per_block = block;
+  sim.make_wet(20e3, 3e-3);
+  sim.cycle(steps);
+  std::size_t hill = 0, lin = 0;
+  for (std::size_t c = 0; c < sim.contacts.size(); ++c)
+    if (sim.contacts.exists[c] && sim.contacts.key[c].kind == ContactKind::BallBall)
+      (sim.contacts.model[c] == ModelKind::Hill ? hill : lin) += 1;
+  EXPECT_GT(hill, 3000u);
+  EXPECT_GT(lin, 1000u);
+  omp_set_num_threads(omp_get_num_procs());
+  return {sim.balls.contact_force, sim.balls.contact_moment};
+}
+
+TEST(Threads, MixedModelsGiveTheSameBitsForAnyThreadsAndBlocks) {
+  const auto one = mixed_box_forces(1, 20, Simulation::kDefaultBallsPerBlock);
+  const auto two = mixed_box_forces(2, 20, Simulation::kDefaultBallsPerBlock);
+  const auto three = mixed_box_forces(3, 20, 1);
+  ASSERT_EQ(one.first.size(), two.first.size());
+  EXPECT_EQ(differing_balls(one, two), 0u);
+  EXPECT_EQ(differing_balls(one, three), 0u);
+}
+
+// The contacts' reported columns (gap, F_c, F_n, F^m, |F*_s|, active) are written on the last cycle of a
 // cycle() call and on every cycle while an observer is registered, and skipped by the batched
 // ball-ball contacts in between (Simulation::cycle). With a fixed time step (no stiffness sums read
 // them), a run with no observer must end with the same columns and the same bits as one with an
@@ -211,12 +255,13 @@ TEST(ContactResults, WrittenOnTheLastCycleAndForObservers) {
     sim.make_wet(20e3, 0.3e-3);  // some bridges: F^m reported
     return sim;
   };
-  // Σ F_n + Σ F^m + Σ |F*_s| + Σ gap over active contacts: one number per cycle for the observer.
+  // Σ F_n + Σ F^m + Σ |F*_s| + Σ gap + Σ |F_c| over active contacts: one number per cycle for the observer.
   auto summary = [](const Simulation& s) {
     double sum = 0.0;
     for (std::size_t c = 0; c < s.contacts.size(); ++c)
       if (s.contacts.active[c])
-        sum += s.contacts.normal_force[c] + s.contacts.moisture_force[c] + s.contacts.trial_shear[c] + s.contacts.gap[c];
+        sum += s.contacts.normal_force[c] + s.contacts.moisture_force[c] + s.contacts.trial_shear[c] + s.contacts.gap[c] +
+               norm(s.contacts.force[c]);
     return sum;
   };
   constexpr int kSteps = 120;
@@ -229,6 +274,7 @@ TEST(ContactResults, WrittenOnTheLastCycleAndForObservers) {
   EXPECT_EQ(quiet.balls.position, watched.balls.position);
   EXPECT_EQ(quiet.balls.spin, watched.balls.spin);
   EXPECT_EQ(quiet.contacts.gap, watched.contacts.gap);
+  EXPECT_EQ(quiet.contacts.force, watched.contacts.force);
   EXPECT_EQ(quiet.contacts.normal_force, watched.contacts.normal_force);
   EXPECT_EQ(quiet.contacts.moisture_force, watched.contacts.moisture_force);
   EXPECT_EQ(quiet.contacts.trial_shear, watched.contacts.trial_shear);

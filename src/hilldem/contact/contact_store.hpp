@@ -54,9 +54,9 @@ class ContactStore {
   // Results of the last force-displacement pass
   // Only what the cycle needs is stored (each column costs memory traffic on every step): the shear
   // force is derived from these (shear_force()), the moments from n̂_c × F_c in the force pass. gap,
-  // normal_force, moisture_force, trial_shear and active are written for the cycles someone may read
-  // them (Simulation::cycle: the last of a call, and every cycle while observers or controllers are
-  // registered).
+  // force, normal_force, moisture_force, trial_shear and active of ball-ball rows are written for the
+  // cycles someone may read them (Simulation::cycle: the last of a call, and every cycle while
+  // observers or controllers are registered); the force pass sums the balls' forces without them.
   std::vector<double> gap;             // g_c [m]
   std::vector<Vec3> force;             // F_c = (F_n + F^m) n̂_c + F_s on piece 2 [N]
   std::vector<double> normal_force;    // F_n (linear) or F^s_n (hill) [N], compression positive

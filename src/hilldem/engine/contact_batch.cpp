@@ -162,20 +162,16 @@ void hill_batch_forces(ContactBatch& batch, double dt, bool want_stiffness) {
   double* __restrict k_tran = batch.col(F::kKtran);
   double* __restrict k_shear = batch.col(F::kKshear);
 
-  // 0. The mapping of each contact (hill_mapping, spec §2.4), from the per-ball terms.
+  // 0. The mapping of each contact (hill_mapping, spec §2.4), from the sums of the per-ball terms.
   {
-    const double* __restrict ir1 = batch.col(F::kIr1);
-    const double* __restrict ir2 = batch.col(F::kIr2);
-    const double* __restrict im1 = batch.col(F::kIm1);
-    const double* __restrict im2 = batch.col(F::kIm2);
-    const double* __restrict cn1 = batch.col(F::kCn1);
-    const double* __restrict cn2 = batch.col(F::kCn2);
-    const double* __restrict cs1 = batch.col(F::kCs1);
-    const double* __restrict cs2 = batch.col(F::kCs2);
+    const double* __restrict ir = batch.col(F::kIr);
+    const double* __restrict im = batch.col(F::kIm);
+    const double* __restrict cn = batch.col(F::kCn);
+    const double* __restrict cs = batch.col(F::kCs);
 #pragma omp simd
     for (std::size_t i = 0; i < n; ++i) {
-      const HillMapping m = hill_mapping(HillParams{0.0, damp[i], 0.0}, HillBodyTerms{ir1[i], im1[i], cn1[i], cs1[i]},
-                                         HillBodyTerms{ir2[i], im2[i], cn2[i], cs2[i]}, std::min(r1[i], r2[i]));
+      const HillMapping m = hill_mapping_of_sums(HillParams{0.0, damp[i], 0.0}, HillBodyTerms{ir[i], im[i], cn[i], cs[i]},
+                                                 std::min(r1[i], r2[i]));
       kn[i] = m.kn, ks[i] = m.ks, bn[i] = m.bn, bs[i] = m.bs, ro[i] = m.r_o;
     }
   }
@@ -252,8 +248,8 @@ void linear_batch_forces(ContactBatch& batch, double dt, bool want_stiffness) {
   const std::size_t n = batch.pad_lanes();
   batch_geometry(batch, n);
   const Cols n_new = cols(batch, F::kNx);
-  const double* __restrict kn = batch.col(F::kIr1);
-  const double* __restrict ks = batch.col(F::kIr2);
+  const double* __restrict kn = batch.col(F::kIr);
+  const double* __restrict ks = batch.col(F::kIm);
   const double* __restrict fric = batch.col(F::kFric);
   const double* __restrict gap = batch.col(F::kGap);
   double* __restrict ruptured = batch.col(F::kRuptured);

@@ -30,9 +30,11 @@ class ContactBatch {
     kWbx, kWby, kWbz,   // spin of ball 2 [rad/s]
     kNox, kNoy, kNoz,   // n̂_c of the last step
     kSx, kSy, kSz,      // F^h_s of the last step [N], in its plane
-    // hill: the per-ball terms of the mapping; linear: kIr1 = k_n, kIr2 = k_s [N/m] (LinearMapping)
-    kIr1, kIr2, kIm1, kIm2,   // 1/R [1/m], 1/m [1/kg] of balls 1 and 2 (HillBodyTerms)
-    kCn1, kCn2, kCs1, kCs2,   // (1 − ν²)/E, 2(2 − ν)(1 + ν)/E [1/Pa] of balls 1 and 2
+    // hill: the sums of the two balls' terms of the mapping (HillBodyTerms: 1/R1 + 1/R2 [1/m],
+    // 1/m1 + 1/m2 [1/kg], Σ(1 − ν²)/E, Σ 2(2 − ν)(1 + ν)/E [1/Pa]), the first step of the mapping
+    // (hill_mapping), done in the gather: four fields instead of eight;
+    // linear: kIr = k_n, kIm = k_s [N/m] (LinearMapping)
+    kIr, kIm, kCn, kCs,
     kFric, kSuction, kDamp,   // μ [-], ψ [Pa], γ_h [-]
     kWet,               // 1 if M = 2 (wet) at the start of the step, else 0
     // the mapping (spec §2.4, Table 4), built from the terms above
@@ -83,7 +85,7 @@ class ContactBatch {
 // want_stiffness is set, Eqs. 19-21.
 void hill_batch_forces(ContactBatch& batch, double dt, bool want_stiffness);
 
-// The linear law (spec §3) of every lane: k_n, k_s in kIr1, kIr2, μ in kFric; the same outputs (F^m,
+// The linear law (spec §3) of every lane: k_n, k_s in kIr, kIm, μ in kFric; the same outputs (F^m,
 // rupture 0; the stiffnesses k_n, k_s when want_stiffness).
 void linear_batch_forces(ContactBatch& batch, double dt, bool want_stiffness);
 

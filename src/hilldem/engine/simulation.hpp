@@ -83,12 +83,13 @@ class Simulation {
   // at t: servos and other controllers set wall or ball velocities here.
   std::vector<std::function<void(Simulation&, double)>> controllers;
 
-  // Run n cycles. The contacts' reported results (ContactStore gap, normal_force, moisture_force,
-  // trial_shear, active) are those of the last cycle when it returns, and of every cycle for the
-  // observers and controllers while any is registered; between those, the batched ball-ball
-  // contacts skip writing them (memory traffic: 1.05 × on the 100,800-sphere bench, whose cycles
-  // nobody watches). The history, F_c and everything the next cycle uses are written on every cycle,
-  // so results do not depend on it (test ContactResults.WrittenOnTheLastCycleAndForObservers).
+  // Run n cycles. The contacts' reported results (ContactStore gap, force, normal_force,
+  // moisture_force, trial_shear, active) are those of the last cycle when it returns, and of every
+  // cycle for the observers and controllers while any is registered; between those, the batched
+  // ball-ball contacts skip writing them (memory traffic: on the 100,800-sphere bench, whose cycles
+  // nobody watches). The history and everything the next cycle uses are written on every cycle, and
+  // the balls' force sums do not read these columns, so results do not depend on it (test
+  // ContactResults.WrittenOnTheLastCycleAndForObservers).
   void cycle(std::int64_t n);
   // Cycle (at least once) until the mean unbalanced-force ratio is ≤ ratio; returns the cycles
   // used, or -1 if max_steps passed first. (Every cycle's contact results are written.)

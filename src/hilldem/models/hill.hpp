@@ -63,14 +63,13 @@ HILLDEM_INLINE HillBodyTerms hill_body_terms(double r, double e, double nu, doub
   return {1.0 / r, 1.0 / m, (1.0 - nu * nu) / e, 2.0 * (2.0 - nu) * (1.0 + nu) / e};
 }
 
-// Table 4 mappings from the two bodies' terms; r_o = min(R1, R2) [m].
-HILLDEM_INLINE HillMapping hill_mapping(const HillParams& p, const HillBodyTerms& t1, const HillBodyTerms& t2,
-                                        double r_o) {
+// Table 4 mappings from the sums of the two bodies' terms (t1 + t2, field by field); r_o = min(R1, R2) [m].
+HILLDEM_INLINE HillMapping hill_mapping_of_sums(const HillParams& p, const HillBodyTerms& sum, double r_o) {
   HillMapping m;
-  m.eff_radius = 1.0 / (t1.inv_radius + t2.inv_radius);
-  m.eff_young = 1.0 / (t1.normal + t2.normal);
-  m.eff_shear = 1.0 / (t1.shear + t2.shear);
-  m.eff_mass = 1.0 / (t1.inv_mass + t2.inv_mass);
+  m.eff_radius = 1.0 / sum.inv_radius;
+  m.eff_young = 1.0 / sum.normal;
+  m.eff_shear = 1.0 / sum.shear;
+  m.eff_mass = 1.0 / sum.inv_mass;
   const double sqrt_re = std::sqrt(m.eff_radius);
   m.kn = 4.0 / 3.0 * m.eff_young * sqrt_re;
   m.ks = 8.0 * m.eff_shear * sqrt_re;
@@ -78,6 +77,15 @@ HILLDEM_INLINE HillMapping hill_mapping(const HillParams& p, const HillBodyTerms
   m.bs = p.damp_con * std::sqrt(m.eff_mass * m.ks);
   m.r_o = r_o;
   return m;
+}
+
+// Table 4 mappings from the two bodies' terms; r_o = min(R1, R2) [m].
+HILLDEM_INLINE HillMapping hill_mapping(const HillParams& p, const HillBodyTerms& t1, const HillBodyTerms& t2,
+                                        double r_o) {
+  return hill_mapping_of_sums(p,
+                              {t1.inv_radius + t2.inv_radius, t1.inv_mass + t2.inv_mass, t1.normal + t2.normal,
+                               t1.shear + t2.shear},
+                              r_o);
 }
 
 inline HillMapping hill_mapping(const HillParams& p, const HillBodies& b) {
