@@ -279,6 +279,9 @@ class Simulation {
   std::vector<std::uint32_t> ball_contacts_;
   std::vector<std::size_t> work_start_;        // threads' ranges of balls in the force pass (split_work)
   std::vector<std::uint64_t> work_prefix_;     // split_work's running sum of work per ball
+  std::size_t split_rows_ = 0;                 // rows when the split was made
+  int split_age_ = 0;                          // force passes since
+  static constexpr int kSplitEvery = 50;
   bool body_terms_ready_ = false;            // ball_kin_[i].terms are up to date (see force_pass)
   std::vector<double> scaled_mass_, scaled_inertia_;  // density scaling [kg], [kg m²]
 };
