@@ -685,8 +685,6 @@ void Simulation::force_pass(double dt) {
   ball_kin_.resize(n);
   const std::size_t wall_rows = wall_rows_.size();
   ball_contacts_.resize(n);
-  balls.contact_force.resize(n);
-  balls.contact_moment.resize(n);
 #pragma omp parallel reduction(min : bad_row) reduction(+ : batched) if (n > kParallelMin)
   {
     // What the pair loop reads of each ball, in one record (two cache lines): one memory stream per
@@ -768,21 +766,18 @@ void Simulation::collect_forces() {
       if (want_stiffness)
         add_stiffness(s.k_tran, s.k_shear, balls.radius[s.b], s.gap, ball_k_tran_[s.b], ball_k_rot_[s.b]);
     }
-  for (std::uint32_t c : wall_rows_) {
-    const std::size_t i = contacts.key[c].a;
-    ball_force[i] -= contacts.force[c];
-    ball_moment[i] += share_moment_[c];
-    if (want_stiffness) add_row_stiffness(c, balls.radius[i], ball_k_tran_[i], ball_k_rot_[i]);
-  }
-  stiffness_ready_ = want_stiffness;
   for (Wall& w : walls.walls) {
     w.force = w.moment = Vec3{};
     w.normal_force = w.normal_stiffness = 0.0;
     w.active_contacts = 0;
   }
+  // Each wall row: the end of its ball's sums, and the wall's sums (both in row order).
   for (std::uint32_t c : wall_rows_) {
-    if (!contacts.active[c]) continue;
     const ContactKey& k = contacts.key[c];
+    ball_force[k.a] -= contacts.force[c];
+    ball_moment[k.a] += share_moment_[c];
+    if (want_stiffness) add_row_stiffness(c, balls.radius[k.a], ball_k_tran_[k.a], ball_k_rot_[k.a]);
+    if (!contacts.active[c]) continue;
     Wall& w = walls.walls[k.b];
     const Vec3 point = balls.position[k.a] + contacts.normal[c] * (balls.radius[k.a] + 0.5 * contacts.gap[c]);
     w.force += contacts.force[c];
@@ -791,6 +786,7 @@ void Simulation::collect_forces() {
     w.normal_stiffness += contacts.model[c] == ModelKind::Linear ? contacts.linear_map[c].kn : contacts.k_tran[c];
     ++w.active_contacts;
   }
+  stiffness_ready_ = want_stiffness;
 }
 
 void Simulation::add_row_stiffness(std::size_t c, double radius, double& k_tran, double& k_rot) const {
