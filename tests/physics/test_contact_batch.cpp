@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 #include <tuple>
 
 #include "sim_builders.hpp"
@@ -190,6 +191,106 @@ TEST(ContactBatch, ResultsDoNotDependOnTheBlockSize) {
     EXPECT_EQ(l.position, linear_ref.position) << "linear, blocks of " << block;
     EXPECT_EQ(l.spin, linear_ref.spin) << "linear, blocks of " << block;
   }
+}
+
+// Ball-wall rows through the linear batch (Simulation::wall_block) against force_row: a layer of
+// 36 grains (apart from each other) on a floor that rises and spins about the vertical, inside a
+// cylinder that contracts and turns about its axis, under a tilted facet that comes down and slides
+// sideways, every grain with its own velocity and spin. The same motion to rounding, and the same
+// wall force sums.
+TEST(WallBatch, SameMotionAsTheRowByRowLawWithMovingWalls) {
+  const double r = 2.5e-3, pitch = 5.2e-3;  // [m]
+  auto run = [&](bool batched) {
+    Simulation sim;
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> vel(-0.01, 0.01), spin(-5.0, 5.0);
+    for (int i = 0; i < 6; ++i)
+      for (int j = 0; j < 6; ++j) {
+        const Vec3 x{(i - 2.5) * pitch, (j - 2.5) * pitch, r - 1e-6};  // 1 µm into the floor
+        sim.balls.add(granite(6 * i + j + 1, x, r, {vel(rng), vel(rng), vel(rng)}));
+        sim.balls.spin.back() = {spin(rng), spin(rng), spin(rng)};
+      }
+    sim.table.rules.push_back(hill_rule(0.4, 0.07));
+    sim.table.rules.push_back(linear_wall_rule(50e3, 0.3));  // soft walls: the grains stay on them
+    Wall floor;
+    floor.name = "floor";
+    floor.velocity = {0, 0, 0.01};  // [m/s]
+    floor.spin = {0, 0, 2.0};       // [rad/s] about the origin
+    sim.walls.add(floor);
+    Wall cylinder;
+    cylinder.name = "cylinder";
+    cylinder.shape = WallShape::Cylinder;
+    cylinder.radius = std::sqrt(2.0) * 2.5 * pitch + r - 1e-6;  // [m] 1 µm into the corner grains
+    cylinder.radial_velocity = -0.01;  // [m/s]
+    cylinder.spin = {0, 0, -3.0};      // [rad/s]
+    sim.walls.add(cylinder);
+    Wall roof;
+    roof.name = "roof";
+    roof.shape = WallShape::Facet;
+    // [m] rising 0.2 mm over 30 mm in x and in y, and ≈ 1 µm into the top of the corner grain
+    // (-13, -13) mm (the plane's height there is h0 + 0.2 mm × 14/30)
+    const double h0 = 2 * r - 2e-6 - 0.2e-3 * 14.0 / 30.0;
+    roof.vertex[0] = {-0.02, -0.02, h0};
+    roof.vertex[1] = {0.01, -0.02, h0 + 0.2e-3};
+    roof.vertex[2] = {-0.02, 0.01, h0 + 0.2e-3};
+    roof.velocity = {0.005, 0, -0.01};  // [m/s]
+    sim.walls.add(roof);
+    sim.use_batched_kernel = batched;
+    sim.settings.gravity = {0, 0, -9.81};
+    sim.settings.auto_timestep = false;
+    sim.settings.timestep = 1e-6;  // [s]
+    sim.cycle(2000);
+    std::vector<std::size_t> wall_contacts(3, 0);
+    for (std::size_t c = 0; c < sim.contacts.size(); ++c)
+      if (sim.contacts.exists[c] && sim.contacts.key[c].kind == ContactKind::BallWall)
+        ++wall_contacts[sim.contacts.key[c].b];
+    std::vector<Vec3> wall_force;
+    for (const Wall& w : sim.walls.walls) wall_force.push_back(w.force);
+    return std::make_tuple(outcome(sim), wall_contacts, wall_force);
+  };
+  const auto [batch, batch_walls, batch_force] = run(true);
+  const auto [rows, rows_walls, rows_force] = run(false);
+  EXPECT_EQ(batch_walls, rows_walls);
+  EXPECT_EQ(batch_walls[0], 36u);  // every grain still on the floor
+  EXPECT_GE(batch_walls[1], 4u);   // the corner grains against the cylinder
+  EXPECT_GE(batch_walls[2], 1u);   // under the roof
+  EXPECT_GE(batch.batched, 36 + 4 + 1);
+  EXPECT_EQ(rows.batched, 0);
+  EXPECT_LT(worst_position_gap(batch, rows), 1e-15) << worst_position_gap(batch, rows);
+  for (std::size_t w = 0; w < batch_force.size(); ++w) {
+    EXPECT_GT(norm(rows_force[w]), 0.0) << "wall " << w;
+    EXPECT_LT(norm(batch_force[w] - rows_force[w]), 1e-9 * norm(rows_force[w])) << "wall " << w;
+  }
+}
+
+// One ball pressed into the corner of a floor and a cylinder (no ball-ball rows): both of its wall
+// contacts go through the batch, and give the row-by-row law's forces to rounding.
+TEST(WallBatch, WallContactsGoThroughTheBatch) {
+  auto run = [](bool batched) {
+    Simulation sim;
+    sim.balls.add(granite(1, {0.0149, 0, 5e-3 - 1e-6}, 5e-3, {0.01, 0.02, -0.03}));  // 1 µm into the floor
+    sim.balls.spin[0] = {3, -2, 5};  // [rad/s]
+    sim.table.rules.push_back(linear_wall_rule(500e6, 0.4));
+    Wall floor;
+    floor.name = "floor";
+    sim.walls.add(floor);
+    Wall cylinder;
+    cylinder.name = "cylinder";
+    cylinder.shape = WallShape::Cylinder;
+    cylinder.radius = 0.0149 + 5e-3 - 1e-6;  // [m] 1 µm into the cylinder
+    sim.walls.add(cylinder);
+    sim.use_batched_kernel = batched;
+    sim.settings.auto_timestep = false;
+    sim.settings.timestep = 1e-6;
+    sim.cycle(5);
+    return std::make_pair(sim.batched_rows(), sim.balls.contact_force[0]);
+  };
+  const auto [batch_rows, batch_force] = run(true);
+  const auto [row_rows, row_force] = run(false);
+  EXPECT_EQ(batch_rows, 2);
+  EXPECT_EQ(row_rows, 0);
+  EXPECT_GT(norm(row_force), 1.0);  // [N] pressed into both walls
+  EXPECT_LT(norm(batch_force - row_force), 1e-12 * norm(row_force));
 }
 
 }  // namespace

@@ -141,6 +141,11 @@ std::size_t ContactBatch::pad_lanes() {
   return padded;
 }
 
+void ContactBatch::pad_geometry(std::size_t padded) {
+  for (int f : {kNx, kNy, kNz, kGap})
+    for (std::size_t lane = size_; lane < padded; ++lane) data_[f][lane] = data_[f][size_ - 1];
+}
+
 void hill_batch_forces(ContactBatch& batch, double dt, bool want_stiffness) {
   using F = ContactBatch;
   const std::size_t n = batch.pad_lanes();
@@ -243,10 +248,11 @@ void hill_batch_forces(ContactBatch& batch, double dt, bool want_stiffness) {
   }
 }
 
-void linear_batch_forces(ContactBatch& batch, double dt, bool want_stiffness) {
+void linear_batch_forces(ContactBatch& batch, double dt, bool want_stiffness, bool geometry_given) {
   using F = ContactBatch;
   const std::size_t n = batch.pad_lanes();
-  batch_geometry(batch, n);
+  if (geometry_given) batch.pad_geometry(n);
+  else batch_geometry(batch, n);
   const Cols n_new = cols(batch, F::kNx);
   const double* __restrict kn = batch.col(F::kIr);
   const double* __restrict ks = batch.col(F::kIm);

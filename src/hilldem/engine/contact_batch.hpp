@@ -69,6 +69,8 @@ class ContactBatch {
   // differently), so a contact's result does not depend on how contacts fall into batches, and the
   // block size of the force pass is a pure tuning knob. Their results are never read.
   std::size_t pad_lanes();
+  // The same for the geometry columns (kNx..kNz, kGap) when the lanes were given their geometry.
+  void pad_geometry(std::size_t padded);
   static constexpr std::size_t kVector = 8;
   std::uint32_t row(std::size_t lane) const { return row_[lane]; }
   double* col(Field f) { return data_[f]; }
@@ -87,6 +89,10 @@ void hill_batch_forces(ContactBatch& batch, double dt, bool want_stiffness);
 
 // The linear law (spec §3) of every lane: k_n, k_s in kIr, kIm, μ in kFric; the same outputs (F^m,
 // rupture 0; the stiffnesses k_n, k_s when want_stiffness).
-void linear_batch_forces(ContactBatch& batch, double dt, bool want_stiffness);
+// geometry_given: the lanes hold n̂_c and g_c already (kNx..kNz, kGap: ball-wall rows, whose geometry
+// is the wall's, wall_touch), and kDx..kDz are not read. A wall lane holds the wall's surface velocity
+// at x_c in kVbx..kVbz, its spin in kWbx..kWbz (the twist of §1.3) and R2 = −g/2, so that the arm
+// R2 + g/2 of the second body is exactly 0 and ẋ_c(2) is the surface velocity itself (§1.2).
+void linear_batch_forces(ContactBatch& batch, double dt, bool want_stiffness, bool geometry_given = false);
 
 }  // namespace hilldem

@@ -225,6 +225,11 @@ class Simulation {
   void force_block(std::size_t a0, std::size_t a1, std::size_t range_end, double dt, BlockScratch& scratch,
                    std::vector<CrossShare>& crossing, std::size_t& bad_row, std::int64_t& batched,
                    bool count_contacts);
+  // The wall rows wall_rows_[k0..k1): existing linear contacts that touch their wall through a linear
+  // batch (the wall's geometry given), the rest row by row (force_row). Each row's results go to its
+  // columns and share_moment_; collect_forces() sums them in row order, so the batches need no order.
+  void wall_block(std::size_t k0, std::size_t k1, double dt, BlockScratch& scratch, std::size_t& bad_row,
+                  std::int64_t& batched);
   // The end of the force sum: the crossing shares, then each ball's wall rows; the walls' sums.
   void collect_forces();
   void compute_mapping(ContactStore& store, std::size_t c) const;
