@@ -15,6 +15,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "hilldem/core/vec3.hpp"
+
 namespace hilldem {
 
 class ContactBatch {
@@ -75,6 +77,13 @@ class ContactBatch {
   std::uint32_t row(std::size_t lane) const { return row_[lane]; }
   double* col(Field f) { return data_[f]; }
   const double* col(Field f) const { return data_[f]; }
+  // A 3-vector in the three columns from `first` (kDx, kVax, kNx, kFx, ...).
+  void put3(Field first, std::size_t lane, const Vec3& v) {
+    data_[first][lane] = v.x, data_[first + 1][lane] = v.y, data_[first + 2][lane] = v.z;
+  }
+  Vec3 get3(Field first, std::size_t lane) const {
+    return {data_[first][lane], data_[first + 1][lane], data_[first + 2][lane]};
+  }
 
  private:
   std::size_t size_ = 0;

@@ -422,6 +422,29 @@ Simulation::RowShare Simulation::force_row(std::size_t c, double dt) {
   return share;
 }
 
+// A batch lane's results as a row outcome (store_row's input). A wall row's moment on its ball
+// takes the ball's arm (the lane's second arm is the wall's, exactly 0: wall_block); a linear lane
+// never ruptures, so its moisture state stays as it was.
+HILLDEM_INLINE Simulation::RowOutcome Simulation::lane_outcome(const ContactBatch& batch, std::size_t lane,
+                                                              bool wall_row) const {
+  using F = ContactBatch;
+  RowOutcome out;
+  out.normal = batch.get3(F::kNx, lane);
+  out.gap = batch.col(F::kGap)[lane];
+  out.arm1 = batch.col(F::kR1)[lane] + 0.5 * out.gap;
+  out.arm2 = wall_row ? out.arm1 : batch.col(F::kR2)[lane] + 0.5 * out.gap;
+  out.force = batch.get3(F::kFx, lane);
+  out.shear = batch.get3(F::kShx, lane);
+  out.normal_force = batch.col(F::kFn)[lane];
+  out.moisture_force = batch.col(F::kFm)[lane];
+  out.trial_shear = batch.col(F::kTrial)[lane];
+  out.k_tran = batch.col(F::kKtran)[lane];
+  out.k_shear = batch.col(F::kKshear)[lane];
+  out.moisture = batch.col(F::kRuptured)[lane] != 0.0 ? Moisture::Ruptured : contacts.moisture[batch.row(lane)];
+  out.active = batch.col(F::kActive)[lane] != 0.0;
+  return out;
+}
+
 HILLDEM_INLINE void Simulation::store_row(std::size_t c, const RowOutcome& out, bool want_stiffness, bool reported,
                                          RowShare& share) {
   // Deleted when inactive beyond the proximity distance (a wet contact stays active: spec §2.5).
@@ -504,15 +527,6 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
   ContactBatch& linear = scratch.linear;
   hill.clear();
   linear.clear();
-  auto put3 = [](ContactBatch& batch, F::Field f, std::size_t lane, const Vec3& v) {
-    batch.col(f)[lane] = v.x;
-    batch.col(static_cast<F::Field>(f + 1))[lane] = v.y;
-    batch.col(static_cast<F::Field>(f + 2))[lane] = v.z;
-  };
-  auto get3 = [](ContactBatch& batch, F::Field f, std::size_t lane) {
-    return Vec3{batch.col(f)[lane], batch.col(static_cast<F::Field>(f + 1))[lane],
-                batch.col(static_cast<F::Field>(f + 2))[lane]};
-  };
   // Row c's share into its two balls (b beyond this thread's range: into `crossing`, see force_pass).
   auto add_share = [&](std::size_t c, const RowShare& s) __attribute__((always_inline)) {
     if (!s.ok) bad_row = std::min(bad_row, c);
@@ -535,22 +549,8 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
     batched_count += static_cast<std::int64_t>(batch.size());
     for (std::size_t lane = 0; lane < batch.size(); ++lane) {
       const std::size_t c = batch.row(lane);
-      RowOutcome out;
-      out.normal = get3(batch, F::kNx, lane);
-      out.gap = batch.col(F::kGap)[lane];
-      out.arm1 = batch.col(F::kR1)[lane] + 0.5 * out.gap;
-      out.arm2 = batch.col(F::kR2)[lane] + 0.5 * out.gap;
-      out.force = get3(batch, F::kFx, lane);
-      out.shear = get3(batch, F::kShx, lane);
-      out.normal_force = batch.col(F::kFn)[lane];
-      out.moisture_force = batch.col(F::kFm)[lane];
-      out.trial_shear = batch.col(F::kTrial)[lane];
-      out.k_tran = batch.col(F::kKtran)[lane];
-      out.k_shear = batch.col(F::kKshear)[lane];
-      out.moisture = batch.col(F::kRuptured)[lane] != 0.0 ? Moisture::Ruptured : contacts.moisture[c];
-      out.active = batch.col(F::kActive)[lane] != 0.0;
       RowShare share;
-      store_row(c, out, want_stiffness, reported, share);
+      store_row(c, lane_outcome(batch, lane, /*wall_row=*/false), want_stiffness, reported, share);
       add_share(c, share);
     }
     batch.clear();
@@ -610,15 +610,15 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
       if (other.size() > 0) flush(other);
       if (batch.full()) flush(batch);
       const std::size_t lane = batch.add(static_cast<std::uint32_t>(c));
-      put3(batch, F::kDx, lane, d);
+      batch.put3(F::kDx, lane, d);
       batch.col(F::kR1)[lane] = ka.radius;
       batch.col(F::kR2)[lane] = kb.radius;
-      put3(batch, F::kVax, lane, ka.velocity);
-      put3(batch, F::kVbx, lane, kb.velocity);
-      put3(batch, F::kWax, lane, ka.spin);
-      put3(batch, F::kWbx, lane, kb.spin);
-      put3(batch, F::kNox, lane, contacts.normal[c]);
-      put3(batch, F::kSx, lane, contacts.shear_state[c]);
+      batch.put3(F::kVax, lane, ka.velocity);
+      batch.put3(F::kVbx, lane, kb.velocity);
+      batch.put3(F::kWax, lane, ka.spin);
+      batch.put3(F::kWbx, lane, kb.spin);
+      batch.put3(F::kNox, lane, contacts.normal[c]);
+      batch.put3(F::kSx, lane, contacts.shear_state[c]);
       if (is_hill) {
         batch.col(F::kIr)[lane] = ka.terms.inv_radius + kb.terms.inv_radius;
         batch.col(F::kIm)[lane] = ka.terms.inv_mass + kb.terms.inv_mass;
@@ -654,15 +654,6 @@ void Simulation::wall_block(std::size_t k0, std::size_t k1, double dt, BlockScra
   using F = ContactBatch;
   ContactBatch& batch = scratch.linear;
   batch.clear();
-  auto put3 = [&](F::Field f, std::size_t lane, const Vec3& v) {
-    batch.col(f)[lane] = v.x;
-    batch.col(static_cast<F::Field>(f + 1))[lane] = v.y;
-    batch.col(static_cast<F::Field>(f + 2))[lane] = v.z;
-  };
-  auto get3 = [&](F::Field f, std::size_t lane) {
-    return Vec3{batch.col(f)[lane], batch.col(static_cast<F::Field>(f + 1))[lane],
-                batch.col(static_cast<F::Field>(f + 2))[lane]};
-  };
   auto done = [&](std::size_t c, const RowShare& share) {
     share_moment_[c] = share.moment2;
     if (!share.ok) bad_row = std::min(bad_row, c);
@@ -672,21 +663,8 @@ void Simulation::wall_block(std::size_t k0, std::size_t k1, double dt, BlockScra
     batched_count += static_cast<std::int64_t>(batch.size());
     for (std::size_t lane = 0; lane < batch.size(); ++lane) {
       const std::size_t c = batch.row(lane);
-      RowOutcome out;  // (as force_row)
-      out.normal = get3(F::kNx, lane);
-      out.gap = batch.col(F::kGap)[lane];
-      out.arm1 = batch.col(F::kR1)[lane] + 0.5 * out.gap;
-      out.arm2 = out.arm1;  // a wall row is collected by its ball
-      out.force = get3(F::kFx, lane);
-      out.shear = get3(F::kShx, lane);
-      out.normal_force = batch.col(F::kFn)[lane];
-      out.trial_shear = batch.col(F::kTrial)[lane];
-      out.k_tran = batch.col(F::kKtran)[lane];
-      out.k_shear = batch.col(F::kKshear)[lane];
-      out.moisture = contacts.moisture[c];
-      out.active = batch.col(F::kActive)[lane] != 0.0;
       RowShare share;
-      store_row(c, out, want_stiffness, true, share);
+      store_row(c, lane_outcome(batch, lane, /*wall_row=*/true), want_stiffness, true, share);
       done(c, share);
     }
     batch.clear();
@@ -709,16 +687,16 @@ void Simulation::wall_block(std::size_t k0, std::size_t k1, double dt, BlockScra
     if (batch.full()) flush();
     const std::size_t lane = batch.add(static_cast<std::uint32_t>(c));
     const double arm1 = r1 + 0.5 * touch->gap;
-    put3(F::kNx, lane, touch->normal);
+    batch.put3(F::kNx, lane, touch->normal);
     batch.col(F::kGap)[lane] = touch->gap;
     batch.col(F::kR1)[lane] = r1;
     batch.col(F::kR2)[lane] = -0.5 * touch->gap;  // the wall's arm R2 + g/2 is then exactly 0
-    put3(F::kVax, lane, balls.velocity[a]);
-    put3(F::kVbx, lane, wall_point_velocity(w, x1 + touch->normal * arm1));
-    put3(F::kWax, lane, balls.spin[a]);
-    put3(F::kWbx, lane, w.spin);
-    put3(F::kNox, lane, contacts.normal[c]);
-    put3(F::kSx, lane, contacts.shear_state[c]);
+    batch.put3(F::kVax, lane, balls.velocity[a]);
+    batch.put3(F::kVbx, lane, wall_point_velocity(w, x1 + touch->normal * arm1));
+    batch.put3(F::kWax, lane, balls.spin[a]);
+    batch.put3(F::kWbx, lane, w.spin);
+    batch.put3(F::kNox, lane, contacts.normal[c]);
+    batch.put3(F::kSx, lane, contacts.shear_state[c]);
     batch.col(F::kIr)[lane] = contacts.linear_map[c].kn;
     batch.col(F::kIm)[lane] = contacts.linear_map[c].ks;
     batch.col(F::kFric)[lane] = contacts.linear_params[c].fric;

@@ -214,6 +214,8 @@ class Simulation {
   // (spec §2.5); and the pair loop's share into `share`. reported: also the columns that only
   // reports read (see cycle()).
   void store_row(std::size_t c, const RowOutcome& out, bool want_stiffness, bool reported, RowShare& share);
+  // A batch lane's results as a row outcome (wall_row: a ball-wall lane of wall_block).
+  RowOutcome lane_outcome(const ContactBatch& batch, std::size_t lane, bool wall_row) const;
   // What one thread reuses from block to block.
   struct BlockScratch {
     ContactBatch hill, linear;
