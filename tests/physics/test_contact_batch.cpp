@@ -3,9 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <string>
 #include <random>
 #include <tuple>
 
+#include "hilldem/core/error.hpp"
 #include "sim_builders.hpp"
 
 namespace hilldem {
@@ -291,6 +294,57 @@ TEST(WallBatch, WallContactsGoThroughTheBatch) {
   EXPECT_EQ(row_rows, 0);
   EXPECT_GT(norm(row_force), 1.0);  // [N] pressed into both walls
   EXPECT_LT(norm(batch_force - row_force), 1e-12 * norm(row_force));
+}
+
+// The scatter's rare lanes (Simulation::force_block: not kQuick): a batched contact pulled apart
+// beyond the proximity distance is deleted and gives neither ball anything, in the same step as the
+// row-by-row law; and a non-finite force stops the run, naming the pair, on either path.
+TEST(HillBatch, ContactPulledApartIsDeletedInTheBatch) {
+  auto run = [](bool batched) {
+    Simulation sim = granite_row({-1e-6});  // 1 µm overlap
+    sim.use_batched_kernel = batched;
+    sim.balls.velocity[1] = {0.6, 0, 0};  // [m/s] away from ball 1: 0.6 µm a step
+    int step = 0;
+    std::int64_t batched_at_deletion = -1;
+    while (step < 50) {
+      sim.cycle(1);
+      ++step;
+      if (sim.contact_count() == 0) {
+        batched_at_deletion = sim.batched_rows();
+        break;
+      }
+    }
+    return std::make_tuple(step, batched_at_deletion, sim.balls.contact_force[0], sim.balls.contact_moment[1],
+                           sim.balls.position[1]);
+  };
+  const auto [batch_step, batch_rows, batch_force, batch_moment, batch_x] = run(true);
+  const auto [row_step, row_rows, row_force, row_moment, row_x] = run(false);
+  EXPECT_GT(batch_step, 1);  // the contact lived on for a step or more: deleted from the batch
+  EXPECT_LT(batch_step, 50);
+  EXPECT_EQ(batch_step, row_step);
+  EXPECT_EQ(batch_rows, 1);
+  EXPECT_EQ(row_rows, 0);
+  EXPECT_EQ(batch_force, Vec3{});
+  EXPECT_EQ(batch_moment, Vec3{});
+  EXPECT_EQ(row_force, Vec3{});
+  EXPECT_LT(norm(batch_x - row_x), 1e-15);
+}
+
+TEST(HillBatch, NonFiniteForceStopsTheRunNamingThePair) {
+  for (const bool batched : {true, false}) {
+    Simulation sim = granite_row({-1e-6});
+    sim.use_batched_kernel = batched;
+    sim.cycle(1);  // the contact exists from here: the next step takes it through the batch
+    ASSERT_EQ(sim.contact_count(), 1u);
+    sim.balls.spin[1] = {0, 0, std::numeric_limits<double>::infinity()};
+    try {
+      sim.cycle(1);
+      ADD_FAILURE() << "a non-finite contact force went unnoticed (batched " << batched << ")";
+    } catch (const RunError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("non-finite contact force at step 2 between ball 1 and ball 2"), std::string::npos) << what;
+    }
+  }
 }
 
 }  // namespace

@@ -50,6 +50,10 @@ class ContactBatch {
     kActive,            // 1 if active after the step
     kRuptured,          // 1 if the liquid bridge ruptured this step
     kKtran, kKshear,    // k̂_n + k̂_s, k̂_s [N/m] (when asked for)
+    // batch_shares(): what the scatter adds to the two balls' sums
+    kMax, kMay, kMaz,   // moment on ball 1: −(R1 + g/2) n̂ × F_c [N m]
+    kMbx, kMby, kMbz,   // moment on ball 2 (a wall lane: on its ball, see wall_block): −(R2 + g/2) n̂ × F_c [N m]
+    kQuick,             // 1 if the row stays a contact and its force is finite (the scatter's common case)
     kFieldCount
   };
 
@@ -64,6 +68,14 @@ class ContactBatch {
     row_[size_] = row;
     return size_++;
   }
+  // The same, with the row's two balls (ball-ball lanes: the scatter adds to their sums).
+  std::size_t add(std::uint32_t row, std::uint32_t ball1, std::uint32_t ball2) {
+    ball1_[size_] = ball1;
+    ball2_[size_] = ball2;
+    return add(row);
+  }
+  std::uint32_t ball1(std::size_t lane) const { return ball1_[lane]; }
+  std::uint32_t ball2(std::size_t lane) const { return ball2_[lane]; }
   std::size_t size() const { return size_; }
   // Lanes the laws compute: size() rounded up to a whole number of vectors (kVector), the extra
   // lanes holding copies of the last lane's inputs. Every lane is then computed by the vectorised
@@ -89,6 +101,8 @@ class ContactBatch {
   std::size_t size_ = 0;
   alignas(64) double data_[kFieldCount][kLanes];
   std::uint32_t row_[kLanes];
+  std::uint32_t ball1_[kLanes];
+  std::uint32_t ball2_[kLanes];
 };
 
 // The hill law of every lane over a step of dt [s]: geometry (Eqs. 2-3), relative velocity at the
@@ -103,5 +117,10 @@ void hill_batch_forces(ContactBatch& batch, double dt, bool want_stiffness);
 // at x_c in kVbx..kVbz, its spin in kWbx..kWbz (the twist of §1.3) and R2 = −g/2, so that the arm
 // R2 + g/2 of the second body is exactly 0 and ẋ_c(2) is the surface velocity itself (§1.2).
 void linear_batch_forces(ContactBatch& batch, double dt, bool want_stiffness, bool geometry_given = false);
+
+// After either law: each lane's moments on its two bodies (kMax.., kMbx..: −(R + g/2) n̂_c × F_c, the
+// contact point on the normal) and whether the scatter may take it the common way (kQuick: the
+// contact is kept, i.e. active or within `proximity` [m] (spec §2.5), and its force is finite).
+void batch_shares(ContactBatch& batch, double proximity);
 
 }  // namespace hilldem

@@ -216,6 +216,9 @@ class Simulation {
   void store_row(std::size_t c, const RowOutcome& out, bool want_stiffness, bool reported, RowShare& share);
   // A batch lane's results as a row outcome (wall_row: a ball-wall lane of wall_block).
   RowOutcome lane_outcome(const ContactBatch& batch, std::size_t lane, bool wall_row) const;
+  // store_row for a lane that batch_shares() marked kQuick (the contact stays, its force is finite):
+  // the same columns, straight from the lanes. The shares come from the lanes too (kMax.., kMbx..).
+  void store_kept_lane(std::size_t c, const ContactBatch& batch, std::size_t lane, bool want_stiffness, bool reported);
   // What one thread reuses from block to block.
   struct BlockScratch {
     ContactBatch hill, linear;
