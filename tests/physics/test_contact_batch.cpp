@@ -87,6 +87,37 @@ TEST(HillBatch, PropertiesChangedAndRefreshedMidRun) {
   EXPECT_LT(worst_position_gap(batch, rows), 1e-12);
 }
 
+// Contact parameters changed in the middle of a run: μ, γ_h and ψ of every other contact (as a
+// set_contacts stage does, then refresh_mappings()), make_wet again with another suction, and the
+// rule's μ edited so that contacts created from then on differ from the sets made for it. The
+// batched law reads parameter sets (Simulation::refresh_param_sets), not the rows' parameters: it
+// follows every change at the same step as the row-by-row law.
+TEST(HillBatch, ContactParametersChangedMidRun) {
+  auto run = [](bool batched, bool change) {
+    Simulation sim = wet_box(batched);
+    sim.cycle(100);
+    if (change) {
+      for (std::size_t c = 0; c < sim.contacts.size(); c += 2)
+        if (sim.contacts.exists[c] && sim.contacts.model[c] == ModelKind::Hill)
+          sim.contacts.hill_params[c] = HillParams{0.05, 0.5, 80e3};  // μ, γ_h, ψ [Pa]
+      sim.refresh_mappings();
+    }
+    sim.cycle(100);
+    if (change) sim.make_wet(5e3, 0.2e-3);
+    sim.cycle(100);
+    if (change) sim.table.rules.at(0).hill.fric_coef = 0.9;  // new contacts only (create_contact)
+    sim.cycle(200);
+    return outcome(sim);
+  };
+  const Outcome batch = run(true, true), rows = run(false, true), same = run(true, false);
+  EXPECT_GT(batch.batched, 100);
+  EXPECT_EQ(batch.contacts, rows.contacts);
+  EXPECT_EQ(batch.wet, rows.wet);
+  EXPECT_EQ(batch.ruptured, rows.ruptured);
+  EXPECT_LT(worst_position_gap(batch, rows), 1e-12);
+  EXPECT_GT(worst_position_gap(batch, same), 1e-9);  // the changes did change the motion
+}
+
 // A periodic box (x, y, z; no walls) of 400 fast wet grains, shifted so that the boundaries cut the
 // cloud: contacts across the boundaries (periodic images in the gather) and positions wrapped at
 // rebuilds; the same motion either way.

@@ -3,8 +3,12 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
+#include <atomic>
+#include <bit>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <memory>
 #include <numeric>
 #include <sstream>
@@ -27,6 +31,13 @@ HILLDEM_INLINE void add_stiffness(double k_tran_row, double k_shear, double radi
   k_tran += k_tran_row;
   k_rot += k_shear * arm * arm;
 }
+
+// Hill parameters by their bits (refresh_param_sets: a set holds exactly its rows' parameters).
+std::array<std::uint64_t, 3> param_bits(const HillParams& p) {
+  return {std::bit_cast<std::uint64_t>(p.fric_coef), std::bit_cast<std::uint64_t>(p.damp_con),
+          std::bit_cast<std::uint64_t>(p.suction)};
+}
+bool same_bits(const HillParams& x, const HillParams& y) { return param_bits(x) == param_bits(y); }
 }  // namespace
 
 void Simulation::cycle(std::int64_t n) {
@@ -158,10 +169,47 @@ void Simulation::create_contact(std::size_t c, const Vec3& normal) {
   // does: what an earlier contact of the same pair was given (make_wet's suction, a set_contact
   // stage) is gone with it, and the result does not depend on when the list was rebuilt.
   const ModelRule& rule = table.rules[static_cast<std::size_t>(contacts.rule[c])];
-  if (contacts.model[c] == ModelKind::Hill) contacts.hill_params[c] = rule.hill;
-  else contacts.linear_params[c] = rule.linear;
+  if (contacts.model[c] == ModelKind::Hill) {
+    contacts.hill_params[c] = rule.hill;
+    // The row's parameter set: its rule's, if that set still holds the rule's parameters (the table
+    // may have changed since the sets were made); else all sets are made again before the next pass
+    // reads them (this row goes through force_row in this one).
+    const auto r = static_cast<std::size_t>(contacts.rule[c]);
+    if (c < row_hill_set_.size() && r < rule_hill_set_.size() && same_bits(hill_sets_[rule_hill_set_[r]], rule.hill))
+      row_hill_set_[c] = rule_hill_set_[r];
+    else
+      std::atomic_ref<bool>(hill_sets_stale_).store(true, std::memory_order_relaxed);
+  } else {
+    contacts.linear_params[c] = rule.linear;
+  }
   compute_mapping(contacts, c);
   contacts.create(c, normal);
+}
+
+void Simulation::refresh_param_sets() {
+  // The distinct parameters, told apart by their bits, so that each row's set holds exactly its
+  // parameters. Rows mostly share their neighbour's set: one comparison, and a map lookup only when
+  // the parameters change along the rows.
+  std::map<std::array<std::uint64_t, 3>, std::uint32_t> index;
+  hill_sets_.clear();
+  auto intern = [&](const HillParams& p) {
+    const auto [it, added] = index.try_emplace(param_bits(p), static_cast<std::uint32_t>(hill_sets_.size()));
+    if (added) hill_sets_.push_back(p);
+    return it->second;
+  };
+  rule_hill_set_.resize(table.rules.size());
+  for (std::size_t r = 0; r < table.rules.size(); ++r) rule_hill_set_[r] = intern(table.rules[r].hill);
+  const std::size_t rows = contacts.size();
+  row_hill_set_.assign(rows, 0);
+  if (hill_sets_.empty()) hill_sets_.push_back(HillParams{});  // (no rules: every row's index is valid)
+  std::uint32_t last = 0;
+  for (std::size_t c = 0; c < rows; ++c) {
+    if (contacts.model[c] != ModelKind::Hill) continue;
+    const HillParams& p = contacts.hill_params[c];
+    if (!same_bits(hill_sets_[last], p)) last = intern(p);
+    row_hill_set_[c] = last;
+  }
+  hill_sets_stale_ = false;
 }
 
 void Simulation::refresh_mappings() {
@@ -625,7 +673,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
         const std::size_t r = c - kPrefetchColumns;
         __builtin_prefetch(contacts.normal.data() + r, 1);
         __builtin_prefetch(contacts.shear_state.data() + r, 1);
-        __builtin_prefetch(contacts.hill_params.data() + r);
+        __builtin_prefetch(row_hill_set_.data() + r);
       }
       if (far && c >= kPrefetchFlags) {  // the byte columns, and the keys (12 B) half as far
         const std::size_t r = c - kPrefetchFlags;
@@ -672,7 +720,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
         batch.col(F::kIm)[lane] = ka.terms.inv_mass + kb.terms.inv_mass;
         batch.col(F::kCn)[lane] = ka.terms.normal + kb.terms.normal;
         batch.col(F::kCs)[lane] = ka.terms.shear + kb.terms.shear;
-        const HillParams& p = contacts.hill_params[c];
+        const HillParams& p = hill_sets_[row_hill_set_[c]];
         batch.col(F::kFric)[lane] = p.fric_coef, batch.col(F::kSuction)[lane] = p.suction;
         batch.col(F::kDamp)[lane] = p.damp_con;
         batch.col(F::kWet)[lane] = contacts.moisture[c] == Moisture::Wet ? 1.0 : 0.0;
@@ -796,6 +844,7 @@ void Simulation::force_pass(double dt) {
   std::size_t bad_row = rows;
   std::int64_t batched = 0;
   const bool terms_ready = body_terms_ready_ && ball_kin_.size() == n;
+  if (!terms_ready || hill_sets_stale_ || row_hill_set_.size() != rows) refresh_param_sets();
   ball_kin_.resize(n);
   const std::size_t wall_rows = wall_rows_.size();
   ball_contacts_.resize(n);
