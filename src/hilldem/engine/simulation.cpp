@@ -589,7 +589,10 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
   // parameters 32 rows ahead gave 1.11 x at 100,800 spheres (4 pairs; 8, 16 and 32 rows the same);
   // the byte columns and the keys 128 rows ahead 1.07-1.09 x more there, but 0.97 x at 11,200 (the
   // rows in the outer caches), hence only for more than 2^17 rows. (Asking for the flags every 16th
-  // row instead of every row, with no threshold, was 0.91 x at 100,800.)
+  // row instead of every row, with no threshold, was 0.91 x at 100,800.) Below 2^17 rows nothing is
+  // asked for ahead at all: the prefetches' own work (≈ 30 instructions a row) cost more than they
+  // hid there: without them 1.030 x at 11,200 spheres (8 pairs; ≈ 50,000 rows) and 1.034 x in cache
+  // (3,576 spheres, 6 pairs), the lab tests' size (tenth session).
   constexpr std::size_t kPrefetchRows = 16;
   constexpr std::size_t kPrefetchColumns = 32;
   constexpr std::size_t kPrefetchFlags = 128;
@@ -658,30 +661,32 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
     if (want_stiffness) ball_k_tran_[a] = ball_k_rot_[a] = 0.0;
     const BallKin& ka = kin[a];
     for (std::size_t c = first_rows_[a + 1]; c-- > first_rows_[a];) {
-      if (c >= kPrefetchRows) {
-        // The ball record of a neighbour some rows on, and its force sums: the neighbours in the layer
-        // above a ball are a whole layer away in memory, and the hardware prefetcher misses them
-        // (perf annotate).
-        const std::size_t ahead_ball = keys[c - kPrefetchRows].b;
-        const char* ahead = reinterpret_cast<const char*>(kin + ahead_ball);
-        __builtin_prefetch(ahead);
-        __builtin_prefetch(ahead + 64);
-        __builtin_prefetch(ball_force + ahead_ball, 1);
-        __builtin_prefetch(ball_moment + ahead_ball, 1);
-      }
-      if (c >= kPrefetchColumns) {  // the history and the parameters
-        const std::size_t r = c - kPrefetchColumns;
-        __builtin_prefetch(contacts.normal.data() + r, 1);
-        __builtin_prefetch(contacts.shear_state.data() + r, 1);
-        __builtin_prefetch(row_hill_set_.data() + r);
-      }
-      if (far && c >= kPrefetchFlags) {  // the byte columns, and the keys (12 B) half as far
-        const std::size_t r = c - kPrefetchFlags;
-        __builtin_prefetch(contacts.image.data() + r);
-        __builtin_prefetch(contacts.exists.data() + r);
-        __builtin_prefetch(contacts.model.data() + r);
-        __builtin_prefetch(contacts.moisture.data() + r);
-        __builtin_prefetch(keys + r + kPrefetchFlags / 2);
+      if (far) {  // (nothing asked for ahead when the rows fit in the caches: see above)
+        if (c >= kPrefetchRows) {
+          // The ball record of a neighbour some rows on, and its force sums: the neighbours in the layer
+          // above a ball are a whole layer away in memory, and the hardware prefetcher misses them
+          // (perf annotate).
+          const std::size_t ahead_ball = keys[c - kPrefetchRows].b;
+          const char* ahead = reinterpret_cast<const char*>(kin + ahead_ball);
+          __builtin_prefetch(ahead);
+          __builtin_prefetch(ahead + 64);
+          __builtin_prefetch(ball_force + ahead_ball, 1);
+          __builtin_prefetch(ball_moment + ahead_ball, 1);
+        }
+        if (c >= kPrefetchColumns) {  // the history and the parameters
+          const std::size_t r = c - kPrefetchColumns;
+          __builtin_prefetch(contacts.normal.data() + r, 1);
+          __builtin_prefetch(contacts.shear_state.data() + r, 1);
+          __builtin_prefetch(row_hill_set_.data() + r);
+        }
+        if (c >= kPrefetchFlags) {  // the byte columns, and the keys (12 B) half as far
+          const std::size_t r = c - kPrefetchFlags;
+          __builtin_prefetch(contacts.image.data() + r);
+          __builtin_prefetch(contacts.exists.data() + r);
+          __builtin_prefetch(contacts.model.data() + r);
+          __builtin_prefetch(contacts.moisture.data() + r);
+          __builtin_prefetch(keys + r + kPrefetchFlags / 2);
+        }
       }
       const std::size_t b = keys[c].b;
       const BallKin& kb = kin[b];
