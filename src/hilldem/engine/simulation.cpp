@@ -545,8 +545,9 @@ HILLDEM_INLINE void Simulation::store_row(std::size_t c, const RowOutcome& out, 
 HILLDEM_INLINE void Simulation::store_kept_lane(std::size_t c, const ContactBatch& batch, std::size_t lane,
                                                bool want_stiffness, bool reported) {
   // The columns of store_row for a contact that stays (written in the same cases). Going through a
-  // RowOutcome and a RowShare cost ≈ 70 instructions a lane more (callgrind): the outcome's fields
-  // copied, the moments computed one lane at a time, the moisture read back.
+  // RowOutcome and a RowShare cost ≈ 45 instructions a lane more (callgrind: 163 against 108, plus
+  // 11 in batch_shares): the outcome's fields copied, the moments computed one lane at a time, the
+  // moisture read back, the keys read again.
   using F = ContactBatch;
   contacts.shear_state[c] = batch.get3(F::kShx, lane);
   contacts.normal[c] = batch.get3(F::kNx, lane);
@@ -591,8 +592,8 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
   // rows in the outer caches), hence only for more than 2^17 rows. (Asking for the flags every 16th
   // row instead of every row, with no threshold, was 0.91 x at 100,800.) Below 2^17 rows nothing is
   // asked for ahead at all: the prefetches' own work (≈ 30 instructions a row) cost more than they
-  // hid there: without them 1.030 x at 11,200 spheres (8 pairs; ≈ 50,000 rows) and 1.034 x in cache
-  // (3,576 spheres, 6 pairs), the lab tests' size (tenth session).
+  // hid there: without them 1.031 x at 11,200 spheres (6 pairs; ≈ 50,000 rows), 1.059 x in cache
+  // (3,576 spheres, 6 pairs) and 1.015 x on a lab test (4 pairs) (tenth session).
   constexpr std::size_t kPrefetchRows = 16;
   constexpr std::size_t kPrefetchColumns = 32;
   constexpr std::size_t kPrefetchFlags = 128;
