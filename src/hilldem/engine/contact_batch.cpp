@@ -135,7 +135,7 @@ HILLDEM_INLINE void store_lane(const LaneOutputs& o, std::size_t i, bool active,
 
 std::size_t ContactBatch::pad_lanes() {
   static_assert(kLanes % kVector == 0);
-  const std::size_t padded = (size_ + kVector - 1) / kVector * kVector;  // (0 for an empty batch)
+  const std::size_t padded = padded_size();  // (0 for an empty batch)
   for (int f = 0; f < kKn; ++f)  // the inputs
     for (std::size_t lane = size_; lane < padded; ++lane) data_[f][lane] = data_[f][size_ - 1];
   return padded;
@@ -292,7 +292,7 @@ void linear_batch_forces(ContactBatch& batch, double dt, bool want_stiffness, bo
 
 void batch_shares(ContactBatch& batch, double proximity) {
   using F = ContactBatch;
-  const std::size_t n = (batch.size() + F::kVector - 1) / F::kVector * F::kVector;  // (pad_lanes)
+  const std::size_t n = batch.padded_size();  // (filled by the law's pad_lanes)
   const Cols normal = cols(batch, F::kNx), force = cols(batch, F::kFx);
   const Cols ma = cols(batch, F::kMax), mb = cols(batch, F::kMbx);
   const double* __restrict r1 = batch.col(F::kR1);

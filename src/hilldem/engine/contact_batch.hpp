@@ -83,6 +83,8 @@ class ContactBatch {
   // differently), so a contact's result does not depend on how contacts fall into batches, and the
   // block size of the force pass is a pure tuning knob. Their results are never read.
   std::size_t pad_lanes();
+  // size() rounded up to a whole number of vectors: the lanes pad_lanes() fills.
+  std::size_t padded_size() const { return (size_ + kVector - 1) / kVector * kVector; }
   // The same for the geometry columns (kNx..kNz, kGap) when the lanes were given their geometry.
   void pad_geometry(std::size_t padded);
   static constexpr std::size_t kVector = 8;
