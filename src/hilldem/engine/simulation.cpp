@@ -603,20 +603,25 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
   ContactBatch& linear = scratch.linear;
   hill.clear();
   linear.clear();
-  // Row c's share into its two balls (b beyond this thread's range: into `crossing`, see force_pass).
+  // A row's shares into its two balls: −F_c and moment1 into ball a, F_c and moment2 into ball b
+  // (b beyond this thread's range: into `crossing`, see force_pass), and the stiffness terms.
+  auto add_to_balls = [&](std::size_t a, std::size_t b, const Vec3& force, const Vec3& moment1, const Vec3& moment2,
+                          double k_tran, double k_shear, double gap) __attribute__((always_inline)) {
+    ball_force[a] -= force;
+    ball_moment[a] += moment1;
+    if (want_stiffness) add_stiffness(k_tran, k_shear, kin[a].radius, gap, ball_k_tran_[a], ball_k_rot_[a]);
+    if (b < range_end) {
+      ball_force[b] += force;
+      ball_moment[b] += moment2;
+      if (want_stiffness) add_stiffness(k_tran, k_shear, kin[b].radius, gap, ball_k_tran_[b], ball_k_rot_[b]);
+    } else {
+      crossing.push_back({static_cast<std::uint32_t>(b), force, moment2, k_tran, k_shear, gap});
+    }
+  };
+  // Row c's share (share.force is −F_c: x − (−F) is x + F bit for bit).
   auto add_share = [&](std::size_t c, const RowShare& s) __attribute__((always_inline)) {
     if (!s.ok) bad_row = std::min(bad_row, c);
-    const std::size_t a = keys[c].a, b = keys[c].b;
-    ball_force[a] += s.force;
-    ball_moment[a] += s.moment;
-    if (want_stiffness) add_stiffness(s.k_tran, s.k_shear, kin[a].radius, s.gap, ball_k_tran_[a], ball_k_rot_[a]);
-    if (b < range_end) {
-      ball_force[b] -= s.force;  // (+F_c, bit for bit)
-      ball_moment[b] += s.moment2;
-      if (want_stiffness) add_stiffness(s.k_tran, s.k_shear, kin[b].radius, s.gap, ball_k_tran_[b], ball_k_rot_[b]);
-    } else {
-      crossing.push_back({static_cast<std::uint32_t>(b), -s.force, s.moment2, s.k_tran, s.k_shear, s.gap});
-    }
+    add_to_balls(keys[c].a, keys[c].b, -s.force, s.moment, s.moment2, s.k_tran, s.k_shear, s.gap);
   };
   // The law of the gathered lanes, and their results into the rows and the balls.
   auto flush = [&](ContactBatch& batch) {
@@ -633,24 +638,13 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
         add_share(c, share);
         continue;
       }
-      // add_share with the share from the lanes: −F_c and its moment on ball 1, F_c and its moment on
-      // ball 2 (x + (−F) is x − F bit for bit).
+      // The shares from the lanes.
       store_kept_lane(c, batch, lane, want_stiffness, reported);
-      const Vec3 force = batch.get3(F::kFx, lane);
-      const std::size_t a = batch.ball1(lane), b = batch.ball2(lane);
       double k_tran = 0.0, k_shear = 0.0, gap = 0.0;
       if (want_stiffness)
         k_tran = batch.col(F::kKtran)[lane], k_shear = batch.col(F::kKshear)[lane], gap = batch.col(F::kGap)[lane];
-      ball_force[a] -= force;
-      ball_moment[a] += batch.get3(F::kMax, lane);
-      if (want_stiffness) add_stiffness(k_tran, k_shear, kin[a].radius, gap, ball_k_tran_[a], ball_k_rot_[a]);
-      if (b < range_end) {
-        ball_force[b] += force;
-        ball_moment[b] += batch.get3(F::kMbx, lane);
-        if (want_stiffness) add_stiffness(k_tran, k_shear, kin[b].radius, gap, ball_k_tran_[b], ball_k_rot_[b]);
-      } else {
-        crossing.push_back({static_cast<std::uint32_t>(b), force, batch.get3(F::kMbx, lane), k_tran, k_shear, gap});
-      }
+      add_to_balls(batch.ball1(lane), batch.ball2(lane), batch.get3(F::kFx, lane), batch.get3(F::kMax, lane),
+                   batch.get3(F::kMbx, lane), k_tran, k_shear, gap);
     }
     batch.clear();
   };
