@@ -293,26 +293,24 @@ void linear_batch_forces(ContactBatch& batch, double dt, bool want_stiffness, bo
 void batch_shares(ContactBatch& batch, double proximity) {
   using F = ContactBatch;
   const std::size_t n = batch.padded_size();  // (filled by the law's pad_lanes)
-  const Cols normal = cols(batch, F::kNx), force = cols(batch, F::kFx);
+  const LaneInputs in(batch);    // n̂_c, the radii, the gap
+  const LaneOutputs out(batch);  // F_c, the active flag
   const Cols ma = cols(batch, F::kMax), mb = cols(batch, F::kMbx);
-  const double* __restrict r1 = batch.col(F::kR1);
-  const double* __restrict r2 = batch.col(F::kR2);
-  const double* __restrict gap = batch.col(F::kGap);
-  const double* __restrict active = batch.col(F::kActive);
   double* __restrict quick = batch.col(F::kQuick);
 #pragma omp simd
   for (std::size_t i = 0; i < n; ++i) {
-    const double nx = normal.x[i], ny = normal.y[i], nz = normal.z[i];
-    const double fx = force.x[i], fy = force.y[i], fz = force.z[i];
+    const double nx = in.n_new.x[i], ny = in.n_new.y[i], nz = in.n_new.z[i];
+    const double fx = out.force.x[i], fy = out.force.y[i], fz = out.force.z[i];
+    const double g = in.gap[i];
     // n̂ × F_c, then times −(R + g/2): the arithmetic of Simulation::store_row, bit for bit.
     const double tx = ny * fz - nz * fy, ty = nz * fx - nx * fz, tz = nx * fy - ny * fx;
-    const double arm1 = r1[i] + 0.5 * gap[i], arm2 = r2[i] + 0.5 * gap[i];
+    const double arm1 = in.r1[i] + 0.5 * g, arm2 = in.r2[i] + 0.5 * g;
     ma.x[i] = tx * -arm1, ma.y[i] = ty * -arm1, ma.z[i] = tz * -arm1;
     mb.x[i] = tx * -arm2, mb.y[i] = ty * -arm2, mb.z[i] = tz * -arm2;
     const double sum = fx + fy + fz;
     // Finite: sum − sum is 0 (NaN for ±inf and NaN). Kept as a sum of doubles, not a bool
     // combination, which GCC 12 will not vectorise.
-    const double kept = active[i] + (gap[i] <= proximity ? 1.0 : 0.0);
+    const double kept = out.active[i] + (g <= proximity ? 1.0 : 0.0);
     const double finite = sum - sum == 0.0 ? 1.0 : 0.0;
     quick[i] = kept > 0.0 ? finite : 0.0;
   }
