@@ -35,5 +35,26 @@ if [ ${#missing[@]} -gt 0 ]; then
   }
 fi
 
-cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release >/dev/null
+# Profile-guided build (CMakeLists.txt, HILLDEM_PGO; HILLDEM_PGO=0 in the environment turns it off):
+# an instrumented hilldem in $build_dir/pgo/instrumented, trained by scripts/pgo_train.sh whenever it
+# was rebuilt (that is, whenever a source changed), then the real build with its profiles.
+pgo_args=(-DHILLDEM_PGO= -DHILLDEM_PGO_DIR=)
+if [ "${HILLDEM_PGO:-1}" != 0 ]; then
+  mkdir -p "$build_dir/pgo"
+  pgo_root=$(cd "$build_dir/pgo" && pwd)
+  profile="$pgo_root/profile"
+  cmake -S . -B "$pgo_root/instrumented" -DCMAKE_BUILD_TYPE=Release -DHILLDEM_ENABLE_TESTS=OFF \
+    -DHILLDEM_PGO=generate -DHILLDEM_PGO_DIR="$profile" >/dev/null
+  cmake --build "$pgo_root/instrumented" --target hilldem -j"$(nproc)"
+  if [ ! -f "$profile/stamp" ] || [ "$pgo_root/instrumented/hilldem" -nt "$profile/stamp" ]; then
+    echo "setup: training the profile-guided build (scripts/pgo_train.sh)"
+    rm -rf "$profile"
+    mkdir -p "$profile"
+    scripts/pgo_train.sh "$pgo_root/instrumented/hilldem"
+    touch "$profile/stamp"
+  fi
+  pgo_args=(-DHILLDEM_PGO=use -DHILLDEM_PGO_DIR="$profile")
+fi
+
+cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release "${pgo_args[@]}" >/dev/null
 cmake --build "$build_dir" -j"$(nproc)"
