@@ -11,9 +11,11 @@ trap 'rm -rf "$work"' EXIT
 # The memo's test problems: two grains (linear, hill, shear dashpot), the moisture test, the
 # 27-ball assembly, restitution.
 "$hilldem" verify >/dev/null
-# The dense bed: batched hill ball-ball contacts, a linear floor, periodic images; one and two threads.
+# The dense bed: batched hill ball-ball contacts, a linear floor, periodic images; one and two threads,
+# and replicated 3 x 3 (100,800 spheres), where the force pass asks for rows ahead (more than 2^17 rows).
 "$hilldem" bench --steps 200 --warmup 20 --threads 1 >/dev/null
 "$hilldem" bench --steps 40 --warmup 10 --threads 2 >/dev/null
+"$hilldem" bench --replicate 3 --steps 20 --warmup 5 --threads 1 >/dev/null
 # Lab tests at a small scale: genesis (boundary-contraction packing), wetting, servo-controlled walls,
 # the load-unload cycles; hill wet and linear.
 "$hilldem" triaxial --scale 0.3 --wet --cycles 0.02 --final-strain 0.05 --no-plot -q --threads 1 -o "$work/wet" >/dev/null

@@ -37,7 +37,8 @@ fi
 
 # Profile-guided build (CMakeLists.txt, HILLDEM_PGO; HILLDEM_PGO=0 in the environment turns it off):
 # an instrumented hilldem in $build_dir/pgo/instrumented, trained by scripts/pgo_train.sh whenever it
-# was rebuilt (that is, whenever a source changed), then the real build with its profiles.
+# was rebuilt (that is, whenever a source changed) or the training set changed, then the real build
+# with its profiles.
 pgo_args=(-DHILLDEM_PGO= -DHILLDEM_PGO_DIR=)
 if [ "${HILLDEM_PGO:-1}" != 0 ]; then
   mkdir -p "$build_dir/pgo"
@@ -46,7 +47,8 @@ if [ "${HILLDEM_PGO:-1}" != 0 ]; then
   cmake -S . -B "$pgo_root/instrumented" -DCMAKE_BUILD_TYPE=Release -DHILLDEM_ENABLE_TESTS=OFF \
     -DHILLDEM_PGO=generate -DHILLDEM_PGO_DIR="$profile" >/dev/null
   cmake --build "$pgo_root/instrumented" --target hilldem -j"$(nproc)"
-  if [ ! -f "$profile/stamp" ] || [ "$pgo_root/instrumented/hilldem" -nt "$profile/stamp" ]; then
+  if [ ! -f "$profile/stamp" ] || [ "$pgo_root/instrumented/hilldem" -nt "$profile/stamp" ] ||
+     [ scripts/pgo_train.sh -nt "$profile/stamp" ]; then
     echo "setup: training the profile-guided build (scripts/pgo_train.sh)"
     rm -rf "$profile"
     mkdir -p "$profile"
