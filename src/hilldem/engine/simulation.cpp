@@ -864,7 +864,10 @@ void Simulation::force_pass(double dt) {
       if (!terms_ready)
         k.terms = hill_body_terms(balls.radius[i], balls.young_mod[i], balls.pois_ratio[i], balls.mass[i]);
     }
-    auto scratch = std::make_unique<BlockScratch>();  // ≈ 60 kB: on the heap, not the thread's stack
+    // ≈ 60 kB: on the heap, not the thread's stack. Default-initialised: make_unique would zero it on
+    // every pass (≈ 1 % of the in-cache bed's instructions, callgrind; 1.023 x there without, 6 pairs),
+    // and every lane value a law or the scatter uses is written before it is read.
+    std::unique_ptr<BlockScratch> scratch(new BlockScratch);
 #pragma omp single
     {
       // The split is a serial pass over the balls (≈ 2 % of a two-thread step at 100,800 balls) and
