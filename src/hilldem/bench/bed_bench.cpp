@@ -8,10 +8,15 @@
 
 namespace hilldem {
 
+#ifndef HILLDEM_BUILD_KIND
+#define HILLDEM_BUILD_KIND "plain"  // (set by CMakeLists.txt: pgo, pgo-instrumented or plain)
+#endif
+
 std::string BedBenchResult::line() const {
   return fmt::format("particles={} steps={} wall_s={:.3f} particle_steps_per_s={:.4g} contacts_per_particle={:.3f} "
-                     "threads={} rebuilds={}",
-                     particles, steps, wall_seconds, particle_steps_per_second, contacts_per_particle, threads, rebuilds);
+                     "threads={} rebuilds={} build={}",
+                     particles, steps, wall_seconds, particle_steps_per_second, contacts_per_particle, threads, rebuilds,
+                     HILLDEM_BUILD_KIND);
 }
 
 Simulation make_bed(const Packing& packing) {
