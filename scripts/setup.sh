@@ -39,8 +39,14 @@ fi
 # an instrumented hilldem in $build_dir/pgo/instrumented, trained by scripts/pgo_train.sh whenever it
 # was rebuilt (that is, whenever a source changed) or the training set changed, then the real build
 # with its profiles.
+# (GCC only: with another compiler, as CXX=clang++, the build is a plain one.)
 pgo_args=(-DHILLDEM_PGO= -DHILLDEM_PGO_DIR=)
-if [ "${HILLDEM_PGO:-1}" != 0 ]; then
+use_pgo="${HILLDEM_PGO:-1}"
+if [ "$use_pgo" != 0 ] && ! "${CXX:-c++}" -v 2>&1 | grep -q '^gcc version'; then
+  echo "setup: ${CXX:-c++} is not GCC: building without profile guidance"
+  use_pgo=0
+fi
+if [ "$use_pgo" != 0 ]; then
   mkdir -p "$build_dir/pgo"
   pgo_root=$(cd "$build_dir/pgo" && pwd)
   profile="$pgo_root/profile"
