@@ -74,6 +74,14 @@ class ContactBatch {
     ball2_[size_] = ball2;
     return add(row);
   }
+  // The same, with the row's periodic image of ball 2 as well: the force pass fills the lanes' ball
+  // fields (kDx..kWbz, and the hill terms kIr..kCs) from the balls' records at once, when the batch
+  // is run (Simulation::fill_lanes), not row by row.
+  std::size_t add(std::uint32_t row, std::uint32_t ball1, std::uint32_t ball2, std::uint8_t image) {
+    image_[size_] = image;
+    return add(row, ball1, ball2);
+  }
+  std::uint8_t image(std::size_t lane) const { return image_[lane]; }
   std::uint32_t ball1(std::size_t lane) const { return ball1_[lane]; }
   std::uint32_t ball2(std::size_t lane) const { return ball2_[lane]; }
   std::size_t size() const { return size_; }
@@ -105,6 +113,7 @@ class ContactBatch {
   std::uint32_t row_[kLanes];
   std::uint32_t ball1_[kLanes];
   std::uint32_t ball2_[kLanes];
+  std::uint8_t image_[kLanes];
 };
 
 // The hill law of every lane over a step of dt [s]: geometry (Eqs. 2-3), relative velocity at the

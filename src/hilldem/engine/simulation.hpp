@@ -214,6 +214,9 @@ class Simulation {
   // (spec §2.5); and the pair loop's share into `share`. reported: also the columns that only
   // reports read (see cycle()).
   void store_row(std::size_t c, const RowOutcome& out, bool want_stiffness, bool reported, RowShare& share);
+  // The inputs of a batch's lanes (ball-ball rows of force_block), from their rows and the records of
+  // their two balls, when the batch runs.
+  void fill_lanes(ContactBatch& batch, bool hill) const;
   // A batch lane's results as a row outcome (wall_row: a ball-wall lane of wall_block).
   RowOutcome lane_outcome(const ContactBatch& batch, std::size_t lane, bool wall_row) const;
   // store_row for a lane that batch_shares() marked kQuick (the contact stays, its force is finite):
