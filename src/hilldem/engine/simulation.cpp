@@ -604,11 +604,13 @@ HILLDEM_INLINE void transpose8(const __m512d r[8], __m512d c[8]) {
 void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
   // Each lane's inputs: from the records of its two balls x2 − x1 (x2 with its periodic image), the
   // radii, velocities and spins, and for the hill law the sums of the two balls' terms; from its row
-  // the last normal and shear force and the parameters. Copied lane by lane, that is ≈ 40 loads and
-  // 40 stores a lane, and the core stores about one value a cycle (1.3 cycles a field measured
-  // here); with AVX-512 the records of eight lanes are loaded whole and transposed in registers, and
-  // each field is stored once for the eight lanes. The arithmetic is the same (x2 − x1 and the sums,
-  // lane by lane), so the bits are those of the lane-by-lane copy.
+  // the last normal and shear force and the parameters. The ball values copied lane by lane are 28
+  // loads and 28 stores a lane, and this core stores about one value a cycle to different lines
+  // (≈ 1.3 cycles a field, docs/performance.md, twelfth session); with AVX-512 the records of eight
+  // lanes are loaded whole and transposed in registers, and each field is stored once for the eight
+  // lanes (1.05 x at 100,800 spheres). The arithmetic is the same (x2 − x1 and the sums, lane by
+  // lane), so the bits are those of the lane-by-lane copy. (AVX-512 gathers were slower than the
+  // copy here.)
   using F = ContactBatch;
   const BallKin* kin = ball_kin_.data();
   const std::size_t n = batch.size();
