@@ -616,60 +616,63 @@ void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
   const std::size_t n = batch.size();
   std::size_t lane = 0;
 #if defined(__AVX512F__)
-  static_assert(sizeof(BallKin) == 128 && alignof(BallKin) == 64);
-  static_assert(offsetof(BallKin, position) == 0 && offsetof(BallKin, radius) == 24 &&
-                offsetof(BallKin, velocity) == 32 && offsetof(BallKin, spin) == 56 && offsetof(BallKin, terms) == 80);
-  for (; lane < n; lane += 8) {
-    // (A last group of fewer than eight lanes repeats its last lane; the batch has room for 64.)
-    __m512d ra[8], rb[8], a0[8], a1[8], b0[8], b1[8];
-    for (std::size_t k = 0; k < 8; ++k) {
-      const std::size_t l = std::min(lane + k, n - 1);
-      const double* pa = reinterpret_cast<const double*>(kin + batch.ball1(l));
-      const double* pb = reinterpret_cast<const double*>(kin + batch.ball2(l));
-      ra[k] = _mm512_load_pd(pa);
-      rb[k] = _mm512_load_pd(pb);
+  if (use_vector_fill) {
+    static_assert(sizeof(BallKin) == 128 && alignof(BallKin) == 64);
+    static_assert(offsetof(BallKin, position) == 0 && offsetof(BallKin, radius) == 24 &&
+                  offsetof(BallKin, velocity) == 32 && offsetof(BallKin, spin) == 56 && offsetof(BallKin, terms) == 80);
+    for (; lane < n; lane += 8) {
+      // (A last group of fewer than eight lanes repeats its last lane; the batch has room for 64.)
+      __m512d ra[8], rb[8], a0[8], a1[8], b0[8], b1[8];
+      for (std::size_t k = 0; k < 8; ++k) {
+        const std::size_t l = std::min(lane + k, n - 1);
+        const double* pa = reinterpret_cast<const double*>(kin + batch.ball1(l));
+        const double* pb = reinterpret_cast<const double*>(kin + batch.ball2(l));
+        ra[k] = _mm512_load_pd(pa);
+        rb[k] = _mm512_load_pd(pb);
+      }
+      transpose8(ra, a0);  // position, radius, velocity, spin.x
+      transpose8(rb, b0);
+      for (std::size_t k = 0; k < 8; ++k) {
+        const std::size_t l = std::min(lane + k, n - 1);
+        ra[k] = _mm512_load_pd(reinterpret_cast<const double*>(kin + batch.ball1(l)) + 8);
+        rb[k] = _mm512_load_pd(reinterpret_cast<const double*>(kin + batch.ball2(l)) + 8);
+      }
+      transpose8(ra, a1);  // spin.y, spin.z, the four terms, padding
+      transpose8(rb, b1);
+      _mm512_store_pd(batch.col(F::kDx) + lane, _mm512_sub_pd(b0[0], a0[0]));
+      _mm512_store_pd(batch.col(F::kDy) + lane, _mm512_sub_pd(b0[1], a0[1]));
+      _mm512_store_pd(batch.col(F::kDz) + lane, _mm512_sub_pd(b0[2], a0[2]));
+      _mm512_store_pd(batch.col(F::kR1) + lane, a0[3]);
+      _mm512_store_pd(batch.col(F::kR2) + lane, b0[3]);
+      _mm512_store_pd(batch.col(F::kVax) + lane, a0[4]);
+      _mm512_store_pd(batch.col(F::kVay) + lane, a0[5]);
+      _mm512_store_pd(batch.col(F::kVaz) + lane, a0[6]);
+      _mm512_store_pd(batch.col(F::kVbx) + lane, b0[4]);
+      _mm512_store_pd(batch.col(F::kVby) + lane, b0[5]);
+      _mm512_store_pd(batch.col(F::kVbz) + lane, b0[6]);
+      _mm512_store_pd(batch.col(F::kWax) + lane, a0[7]);
+      _mm512_store_pd(batch.col(F::kWay) + lane, a1[0]);
+      _mm512_store_pd(batch.col(F::kWaz) + lane, a1[1]);
+      _mm512_store_pd(batch.col(F::kWbx) + lane, b0[7]);
+      _mm512_store_pd(batch.col(F::kWby) + lane, b1[0]);
+      _mm512_store_pd(batch.col(F::kWbz) + lane, b1[1]);
+      if (hill) {
+        _mm512_store_pd(batch.col(F::kIr) + lane, _mm512_add_pd(a1[2], b1[2]));
+        _mm512_store_pd(batch.col(F::kIm) + lane, _mm512_add_pd(a1[3], b1[3]));
+        _mm512_store_pd(batch.col(F::kCn) + lane, _mm512_add_pd(a1[4], b1[4]));
+        _mm512_store_pd(batch.col(F::kCs) + lane, _mm512_add_pd(a1[5], b1[5]));
+      }
     }
-    transpose8(ra, a0);  // position, radius, velocity, spin.x
-    transpose8(rb, b0);
-    for (std::size_t k = 0; k < 8; ++k) {
-      const std::size_t l = std::min(lane + k, n - 1);
-      ra[k] = _mm512_load_pd(reinterpret_cast<const double*>(kin + batch.ball1(l)) + 8);
-      rb[k] = _mm512_load_pd(reinterpret_cast<const double*>(kin + batch.ball2(l)) + 8);
-    }
-    transpose8(ra, a1);  // spin.y, spin.z, the four terms, padding
-    transpose8(rb, b1);
-    _mm512_store_pd(batch.col(F::kDx) + lane, _mm512_sub_pd(b0[0], a0[0]));
-    _mm512_store_pd(batch.col(F::kDy) + lane, _mm512_sub_pd(b0[1], a0[1]));
-    _mm512_store_pd(batch.col(F::kDz) + lane, _mm512_sub_pd(b0[2], a0[2]));
-    _mm512_store_pd(batch.col(F::kR1) + lane, a0[3]);
-    _mm512_store_pd(batch.col(F::kR2) + lane, b0[3]);
-    _mm512_store_pd(batch.col(F::kVax) + lane, a0[4]);
-    _mm512_store_pd(batch.col(F::kVay) + lane, a0[5]);
-    _mm512_store_pd(batch.col(F::kVaz) + lane, a0[6]);
-    _mm512_store_pd(batch.col(F::kVbx) + lane, b0[4]);
-    _mm512_store_pd(batch.col(F::kVby) + lane, b0[5]);
-    _mm512_store_pd(batch.col(F::kVbz) + lane, b0[6]);
-    _mm512_store_pd(batch.col(F::kWax) + lane, a0[7]);
-    _mm512_store_pd(batch.col(F::kWay) + lane, a1[0]);
-    _mm512_store_pd(batch.col(F::kWaz) + lane, a1[1]);
-    _mm512_store_pd(batch.col(F::kWbx) + lane, b0[7]);
-    _mm512_store_pd(batch.col(F::kWby) + lane, b1[0]);
-    _mm512_store_pd(batch.col(F::kWbz) + lane, b1[1]);
-    if (hill) {
-      _mm512_store_pd(batch.col(F::kIr) + lane, _mm512_add_pd(a1[2], b1[2]));
-      _mm512_store_pd(batch.col(F::kIm) + lane, _mm512_add_pd(a1[3], b1[3]));
-      _mm512_store_pd(batch.col(F::kCn) + lane, _mm512_add_pd(a1[4], b1[4]));
-      _mm512_store_pd(batch.col(F::kCs) + lane, _mm512_add_pd(a1[5], b1[5]));
-    }
+    // Lanes across a periodic boundary: x2 − x1 again with the image (x2 + shift first, as force_row).
+    for (std::size_t l = 0; l < n; ++l)
+      if (batch.image(l) != kNoImage) {
+        const Vec3 x2 = kin[batch.ball2(l)].position + image_shift(batch.image(l), settings.box);
+        batch.put3(F::kDx, l, x2 - kin[batch.ball1(l)].position);
+      }
+    lane = n;
   }
-  // Lanes across a periodic boundary: x2 − x1 again with the image (x2 + shift first, as force_row).
-  for (std::size_t l = 0; l < n; ++l)
-    if (batch.image(l) != kNoImage) {
-      const Vec3 x2 = kin[batch.ball2(l)].position + image_shift(batch.image(l), settings.box);
-      batch.put3(F::kDx, l, x2 - kin[batch.ball1(l)].position);
-    }
-#else
-  for (; lane < n; ++lane) {
+#endif
+  for (; lane < n; ++lane) {  // lane by lane (no AVX-512, or !use_vector_fill)
     const BallKin& ka = kin[batch.ball1(lane)];
     const BallKin& kb = kin[batch.ball2(lane)];
     Vec3 x2 = kb.position;
@@ -688,7 +691,6 @@ void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
       batch.col(F::kCs)[lane] = ka.terms.shear + kb.terms.shear;
     }
   }
-#endif
   // The rows' own inputs, lane by lane. (Eight rows' Vec3s loaded whole and transposed as well, and
   // the parameters set for eight lanes at once: 1.000 x in cache, 16 pairs; not kept.)
   for (lane = 0; lane < n; ++lane) {

@@ -113,6 +113,9 @@ class Simulation {
   // Existing ball-ball contacts go through the batched laws (engine/contact_batch.hpp); false: every
   // row through the row-by-row laws (the two agree to rounding; kept for tests and comparison).
   bool use_batched_kernel = true;
+  // The lanes' ball fields from whole ball records transposed in AVX-512 registers (where the build
+  // has AVX-512); false: copied lane by lane. The same bits either way (kept for tests).
+  bool use_vector_fill = true;
   // Balls per block of the force pass (a block's contacts fill the batches together; blocks are
   // the unit of work of the threads). A tuning knob only: results do not depend on it (the batches
   // pad their lanes, ContactBatch::pad_lanes). 128: docs/performance.md.
