@@ -118,18 +118,24 @@ TEST(HillBatch, ContactParametersChangedMidRun) {
   EXPECT_GT(worst_position_gap(batch, same), 1e-9);  // the changes did change the motion
 }
 
-// A periodic box (x, y, z; no walls) of 400 fast wet grains, shifted so that the boundaries cut the
+// A periodic box (x, y, z; no walls) of 400 fast grains, shifted so that the boundaries cut the
 // cloud: contacts across the boundaries (periodic images in the gather) and positions wrapped at
-// rebuilds; the same motion either way.
+// rebuilds.
+Simulation periodic_cloud() {
+  Simulation sim = random_box(400, 8, /*walls=*/false);
+  sim.settings.box.periodic[0] = sim.settings.box.periodic[1] = sim.settings.box.periodic[2] = true;
+  sim.settings.box.hi = {0.04, 0.04, 0.04};
+  for (std::size_t i = 0; i < sim.balls.size(); ++i) {
+    sim.balls.velocity[i] *= 10.0;                    // [m/s]
+    sim.balls.position[i] += Vec3{0.02, 0.013, 0.0};  // [m] the x and y boundaries now cut the cloud
+  }
+  return sim;
+}
+
+// Wet, the same motion with the batched and the row-by-row laws.
 TEST(HillBatch, SameMotionInAPeriodicBox) {
   auto run = [](bool batched) {
-    Simulation sim = random_box(400, 8, /*walls=*/false);
-    sim.settings.box.periodic[0] = sim.settings.box.periodic[1] = sim.settings.box.periodic[2] = true;
-    sim.settings.box.hi = {0.04, 0.04, 0.04};
-    for (std::size_t i = 0; i < sim.balls.size(); ++i) {
-      sim.balls.velocity[i] *= 10.0;  // [m/s]
-      sim.balls.position[i] += Vec3{0.02, 0.013, 0.0};  // [m] the x and y boundaries now cut the cloud
-    }
+    Simulation sim = periodic_cloud();
     sim.use_batched_kernel = batched;
     sim.make_wet(20e3, 0.5e-3);  // (its rebuild wraps the positions into the box)
     std::size_t across = 0;
@@ -152,13 +158,7 @@ TEST(HillBatch, SameMotionInAPeriodicBox) {
 // same arithmetic, so the same bits, across periodic boundaries (images) and with both laws' lanes.
 TEST(HillBatch, BallFieldsTransposedOrCopiedGiveTheSameBits) {
   auto run = [](bool vector_fill) {
-    Simulation sim = random_box(400, 8, /*walls=*/false);
-    sim.settings.box.periodic[0] = sim.settings.box.periodic[1] = sim.settings.box.periodic[2] = true;
-    sim.settings.box.hi = {0.04, 0.04, 0.04};
-    for (std::size_t i = 0; i < sim.balls.size(); ++i) {
-      sim.balls.velocity[i] *= 10.0;                    // [m/s]
-      sim.balls.position[i] += Vec3{0.02, 0.013, 0.0};  // [m] the boundaries cut the cloud
-    }
+    Simulation sim = periodic_cloud();
     sim.use_vector_fill = vector_fill;
     sim.make_wet(20e3, 0.5e-3);
     sim.cycle(300);

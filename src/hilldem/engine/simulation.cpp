@@ -575,6 +575,17 @@ HILLDEM_INLINE void Simulation::store_kept_lane(std::size_t c, const ContactBatc
   if (reported || want_stiffness) contacts.active[c] = batch.col(F::kActive)[lane] != 0.0;
 }
 
+namespace {
+// x2 − x1 of a ball-ball row [m] from the balls' records, ball 2 shifted by the row's periodic image
+// (x2 + shift first, as force_row and geometry() do).
+template <class Kin>
+HILLDEM_INLINE Vec3 separation(const Kin& ka, const Kin& kb, ImageCode image, const PeriodicBox& box) {
+  Vec3 x2 = kb.position;
+  if (image != kNoImage) x2 += image_shift(image, box);
+  return x2 - ka.position;
+}
+}  // namespace
+
 #if defined(__AVX512F__)
 namespace {
 // The 8 x 8 transpose of doubles: r[i] holds lane i's eight fields, c[j] field j of the eight lanes
@@ -622,20 +633,21 @@ void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
                   offsetof(BallKin, velocity) == 32 && offsetof(BallKin, spin) == 56 && offsetof(BallKin, terms) == 80);
     for (; lane < n; lane += 8) {
       // (A last group of fewer than eight lanes repeats its last lane; the batch has room for 64.)
+      const double* pa[8];
+      const double* pb[8];
       __m512d ra[8], rb[8], a0[8], a1[8], b0[8], b1[8];
       for (std::size_t k = 0; k < 8; ++k) {
         const std::size_t l = std::min(lane + k, n - 1);
-        const double* pa = reinterpret_cast<const double*>(kin + batch.ball1(l));
-        const double* pb = reinterpret_cast<const double*>(kin + batch.ball2(l));
-        ra[k] = _mm512_load_pd(pa);
-        rb[k] = _mm512_load_pd(pb);
+        pa[k] = reinterpret_cast<const double*>(kin + batch.ball1(l));
+        pb[k] = reinterpret_cast<const double*>(kin + batch.ball2(l));
+        ra[k] = _mm512_load_pd(pa[k]);
+        rb[k] = _mm512_load_pd(pb[k]);
       }
       transpose8(ra, a0);  // position, radius, velocity, spin.x
       transpose8(rb, b0);
       for (std::size_t k = 0; k < 8; ++k) {
-        const std::size_t l = std::min(lane + k, n - 1);
-        ra[k] = _mm512_load_pd(reinterpret_cast<const double*>(kin + batch.ball1(l)) + 8);
-        rb[k] = _mm512_load_pd(reinterpret_cast<const double*>(kin + batch.ball2(l)) + 8);
+        ra[k] = _mm512_load_pd(pa[k] + 8);
+        rb[k] = _mm512_load_pd(pb[k] + 8);
       }
       transpose8(ra, a1);  // spin.y, spin.z, the four terms, padding
       transpose8(rb, b1);
@@ -663,21 +675,17 @@ void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
         _mm512_store_pd(batch.col(F::kCs) + lane, _mm512_add_pd(a1[5], b1[5]));
       }
     }
-    // Lanes across a periodic boundary: x2 − x1 again with the image (x2 + shift first, as force_row).
+    // Lanes across a periodic boundary: x2 − x1 again, with the image.
     for (std::size_t l = 0; l < n; ++l)
-      if (batch.image(l) != kNoImage) {
-        const Vec3 x2 = kin[batch.ball2(l)].position + image_shift(batch.image(l), settings.box);
-        batch.put3(F::kDx, l, x2 - kin[batch.ball1(l)].position);
-      }
+      if (batch.image(l) != kNoImage)
+        batch.put3(F::kDx, l, separation(kin[batch.ball1(l)], kin[batch.ball2(l)], batch.image(l), settings.box));
     lane = n;
   }
 #endif
   for (; lane < n; ++lane) {  // lane by lane (no AVX-512, or !use_vector_fill)
     const BallKin& ka = kin[batch.ball1(lane)];
     const BallKin& kb = kin[batch.ball2(lane)];
-    Vec3 x2 = kb.position;
-    if (batch.image(lane) != kNoImage) x2 += image_shift(batch.image(lane), settings.box);
-    batch.put3(F::kDx, lane, x2 - ka.position);
+    batch.put3(F::kDx, lane, separation(ka, kb, batch.image(lane), settings.box));
     batch.col(F::kR1)[lane] = ka.radius;
     batch.col(F::kR2)[lane] = kb.radius;
     batch.put3(F::kVax, lane, ka.velocity);
@@ -831,10 +839,8 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
       const bool exists = contacts.exists[c];
       if (!exists && batched) {  // a neighbour pair: a contact only once within proximity (as force_row)
         const BallKin& kb = kin[b];
-        Vec3 x2 = kb.position;
-        if (contacts.image[c] != kNoImage) x2 += image_shift(contacts.image[c], box);
         const double reach = ka.radius + kb.radius + proximity;
-        if (norm2(x2 - ka.position) > reach * reach) continue;  // gives nothing to either ball
+        if (norm2(separation(ka, kb, contacts.image[c], box)) > reach * reach) continue;  // nothing to either ball
       }
       if (!batched || !exists) {
         if (hill.size() > 0) flush(hill);
