@@ -154,25 +154,47 @@ TEST(HillBatch, SameMotionInAPeriodicBox) {
   EXPECT_LT(worst_position_gap(batch, rows), 1e-12);
 }
 
+// The periodic box after `configure` set an engine switch: 300 steps dry (the fast grains collide:
+// new contacts between the batched ones), then 300 wet.
+template <class Configure>
+Outcome periodic_wet_run(Configure configure) {
+  Simulation sim = periodic_cloud();
+  configure(sim);
+  sim.cycle(300);
+  sim.make_wet(20e3, 0.5e-3);
+  sim.cycle(300);
+  return outcome(sim);
+}
+
+void expect_same_bits(const Outcome& a, const Outcome& b) {
+  EXPECT_GT(a.batched, 50);
+  EXPECT_EQ(a.contacts, b.contacts);
+  ASSERT_EQ(a.position.size(), b.position.size());
+  for (std::size_t i = 0; i < a.position.size(); ++i) {
+    EXPECT_EQ(a.position[i].x, b.position[i].x) << i;
+    EXPECT_EQ(a.position[i].y, b.position[i].y) << i;
+    EXPECT_EQ(a.position[i].z, b.position[i].z) << i;
+    EXPECT_EQ(a.spin[i].x, b.spin[i].x) << i;
+  }
+}
+
 // The lanes' ball fields transposed from whole records (AVX-512 builds) or copied lane by lane: the
 // same arithmetic, so the same bits, across periodic boundaries (images) and with both laws' lanes.
 TEST(HillBatch, BallFieldsTransposedOrCopiedGiveTheSameBits) {
-  auto run = [](bool vector_fill) {
-    Simulation sim = periodic_cloud();
-    sim.use_vector_fill = vector_fill;
-    sim.make_wet(20e3, 0.5e-3);
-    sim.cycle(300);
-    return outcome(sim);
-  };
-  const Outcome vec = run(true), copied = run(false);
-  EXPECT_GT(vec.batched, 50);
-  EXPECT_EQ(vec.contacts, copied.contacts);
-  for (std::size_t i = 0; i < vec.position.size(); ++i) {
-    EXPECT_EQ(vec.position[i].x, copied.position[i].x) << i;
-    EXPECT_EQ(vec.position[i].y, copied.position[i].y) << i;
-    EXPECT_EQ(vec.position[i].z, copied.position[i].z) << i;
-    EXPECT_EQ(vec.spin[i].x, copied.spin[i].x) << i;
-  }
+  expect_same_bits(periodic_wet_run([](Simulation& s) { s.use_vector_fill = true; }),
+                   periodic_wet_run([](Simulation& s) { s.use_vector_fill = false; }));
+}
+
+// The row loop with or without a branch on whether a row is a contact (at any number of rows here):
+// the same lanes in the same order, new contacts (force_row) in their place among them, so the same
+// bits.
+TEST(HillBatch, RowsWithOrWithoutTheContactBranchGiveTheSameBits) {
+  const Outcome branchless = periodic_wet_run([](Simulation& s) {
+    s.use_branchless_rows = true;
+    s.branchless_rows_min = 0;
+  });
+  const Outcome branchy = periodic_wet_run([](Simulation& s) { s.use_branchless_rows = false; });
+  expect_same_bits(branchless, branchy);
 }
 
 // Two wet grains pulled apart: the bridge holds, then ruptures at 2 s_cr (Eq. 12), at the same step

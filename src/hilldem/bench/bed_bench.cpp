@@ -13,6 +13,13 @@ namespace hilldem {
 #endif
 
 std::string BedBenchResult::line() const {
+  if (!alternate.empty())
+    return fmt::format("particles={} steps={} alternate={} off_particle_steps_per_s={:.4g} "
+                       "on_particle_steps_per_s={:.4g} on_over_off={:.3f} contacts_per_particle={:.3f} threads={} "
+                       "rebuilds={} build={}",
+                       particles, steps, alternate, off_particle_steps_per_second, on_particle_steps_per_second,
+                       on_particle_steps_per_second / off_particle_steps_per_second, contacts_per_particle, threads,
+                       rebuilds, HILLDEM_BUILD_KIND);
   return fmt::format("particles={} steps={} wall_s={:.3f} particle_steps_per_s={:.4g} contacts_per_particle={:.3f} "
                      "threads={} rebuilds={} build={}",
                      particles, steps, wall_seconds, particle_steps_per_second, contacts_per_particle, threads, rebuilds,
@@ -77,6 +84,22 @@ std::int64_t settle_bed(const std::string& in, const std::string& out, double ra
   return steps;
 }
 
+const std::vector<std::string>& alternate_switches() {
+  static const std::vector<std::string> names{"vector-fill", "branchless-rows"};
+  return names;
+}
+
+namespace {
+bool& switch_of(Simulation& sim, const std::string& name) {
+  if (name == "vector-fill") return sim.use_vector_fill;
+  if (name == "branchless-rows") {
+    sim.branchless_rows_min = 0;  // (compared at any size)
+    return sim.use_branchless_rows;
+  }
+  throw InputError("bench --alternate: unknown switch '" + name + "' (allowed: vector-fill, branchless-rows)");
+}
+}  // namespace
+
 BedBenchResult run_bed_bench(const BedBenchOptions& o) {
   if (o.threads > 0) omp_set_num_threads(o.threads);
   Packing packing = read_packing(o.data, PackingFormat::Lammps);
@@ -86,14 +109,38 @@ BedBenchResult run_bed_bench(const BedBenchOptions& o) {
   if (o.block > 0) sim.balls_per_block = o.block;
   sim.cycle(o.warmup);
   const std::int64_t rebuilds0 = sim.rebuilds();
-  const auto start = std::chrono::steady_clock::now();
-  sim.cycle(o.steps);
-  const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   BedBenchResult r;
   r.particles = sim.balls.size();
   r.steps = o.steps;
-  r.wall_seconds = secs;
-  r.particle_steps_per_second = static_cast<double>(r.particles) * static_cast<double>(o.steps) / secs;
+  const double particles = static_cast<double>(r.particles);
+  if (o.alternate.empty()) {
+    const auto start = std::chrono::steady_clock::now();
+    sim.cycle(o.steps);
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    r.wall_seconds = secs;
+    r.particle_steps_per_second = particles * static_cast<double>(o.steps) / secs;
+  } else {
+    if (o.alternate_block < 1) throw InputError("bench --alternate-block: must be at least 1 step");
+    bool& on = switch_of(sim, o.alternate);
+    const bool initial = on;
+    double secs[2] = {0.0, 0.0};
+    std::int64_t done[2] = {0, 0};
+    for (std::int64_t k = 0, left = o.steps; left > 0; ++k) {
+      const std::int64_t n = std::min(left, o.alternate_block);
+      on = k % 2 == 1;
+      const auto start = std::chrono::steady_clock::now();
+      sim.cycle(n);
+      secs[k % 2] += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      done[k % 2] += n;
+      left -= n;
+    }
+    on = initial;
+    r.alternate = o.alternate;
+    r.wall_seconds = secs[0] + secs[1];
+    r.particle_steps_per_second = particles * static_cast<double>(o.steps) / r.wall_seconds;
+    r.off_particle_steps_per_second = secs[0] > 0.0 ? particles * static_cast<double>(done[0]) / secs[0] : 0.0;
+    r.on_particle_steps_per_second = secs[1] > 0.0 ? particles * static_cast<double>(done[1]) / secs[1] : 0.0;
+  }
   std::size_t ball_contacts = 0;
   for (std::size_t c = 0; c < sim.contacts.size(); ++c)
     ball_contacts += sim.contacts.active[c] && sim.contacts.key[c].kind == ContactKind::BallBall;

@@ -81,6 +81,16 @@ class ContactBatch {
     image_[size_] = image;
     return add(row, ball1, ball2);
   }
+  // The same, kept only if `keep`: the slot after the last lane is written either way and becomes a
+  // lane only for a row that is a contact, so that the row loop needs no branch on it (see
+  // Simulation::force_block). Only when !full().
+  void add_if(bool keep, std::uint32_t row, std::uint32_t ball1, std::uint32_t ball2, std::uint8_t image) {
+    image_[size_] = image;
+    ball1_[size_] = ball1;
+    ball2_[size_] = ball2;
+    row_[size_] = row;
+    size_ += keep ? 1 : 0;
+  }
   std::uint8_t image(std::size_t lane) const { return image_[lane]; }
   std::uint32_t ball1(std::size_t lane) const { return ball1_[lane]; }
   std::uint32_t ball2(std::size_t lane) const { return ball2_[lane]; }

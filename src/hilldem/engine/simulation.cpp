@@ -729,6 +729,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
   const double proximity = settings.proximity;
   const bool want_stiffness = settings.auto_timestep || settings.density_scaling;
   const bool batched = use_batched_kernel && !settings.track_shear_displacement;
+  const bool branchless = batched && use_branchless_rows && contacts.size() > branchless_rows_min;
   const bool reported = write_results_;
   const PeriodicBox& box = settings.box;
   const BallKin* kin = ball_kin_.data();
@@ -837,6 +838,29 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
       }
       const std::size_t b = keys[c].b;
       const bool exists = contacts.exists[c];
+      if (branchless && contacts.model[c] == ModelKind::Hill) {
+        // A hill row, contact or neighbour pair, without a branch on which it is: whether a row is a
+        // contact follows no pattern the branch predictor can learn once the rows outgrow its
+        // history (≈ 45 % of the bench bed's rows are neighbour pairs). The row always takes the
+        // next lane's slot, which becomes a lane only if it is a contact, and its separation is
+        // checked either way; only a neighbour pair within reach (a new contact: rare) branches.
+        if (linear.size() > 0) flush(linear);
+        if (hill.full()) flush(hill);
+        const ImageCode image = contacts.image[c];
+        hill.add_if(exists, static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b),
+                    image);
+        const BallKin& kb = kin[b];
+        const double reach = ka.radius + kb.radius + proximity;
+        unsigned fresh = static_cast<unsigned>(!exists) & static_cast<unsigned>(norm2(separation(ka, kb, image, box)) <= reach * reach);
+        // One branch, taken rarely: the empty asm makes the compiler compute `fresh` whole, where it
+        // would otherwise branch on the separation first, which is as unpredictable as `exists`.
+        asm("" : "+r"(fresh));
+        if (fresh != 0) [[unlikely]] {  // a contact from now on (force_row), in row order
+          if (hill.size() > 0) flush(hill);
+          add_share(c, force_row(c, dt));
+        }
+        continue;
+      }
       if (!exists && batched) {  // a neighbour pair: a contact only once within proximity (as force_row)
         const BallKin& kb = kin[b];
         const double reach = ka.radius + kb.radius + proximity;

@@ -116,6 +116,14 @@ class Simulation {
   // The lanes' ball fields from whole ball records transposed in AVX-512 registers (where the build
   // has AVX-512); false: copied lane by lane. The same bits either way (kept for tests).
   bool use_vector_fill = true;
+  // Hill rows (contacts and neighbour pairs alike) through the force pass's row loop without a branch
+  // on whether the row is a contact (force_block), when there are more than branchless_rows_min rows;
+  // false, or fewer rows: with that branch. The same bits either way. Below ≈ 15,000 rows the branch
+  // predictor learns which rows are contacts (the pattern repeats every step) and the branch is the
+  // faster way (0.94-0.96 x without it, 3,713 spheres); at 11,200 spheres (≈ 47,000 rows) it no longer
+  // does, and the loop without the branch is 1.14 x faster (docs/performance.md, thirteenth session).
+  bool use_branchless_rows = true;
+  std::size_t branchless_rows_min = std::size_t{1} << 15;
   // Balls per block of the force pass (a block's contacts fill the batches together; blocks are
   // the unit of work of the threads). A tuning knob only: results do not depend on it (the batches
   // pad their lanes, ContactBatch::pad_lanes). 128: docs/performance.md.
