@@ -749,6 +749,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
   constexpr std::size_t kPrefetchRows = 16;
   constexpr std::size_t kPrefetchColumns = 32;
   constexpr std::size_t kPrefetchFlags = 128;
+  constexpr std::size_t kPrefetchBalls = 8;
   const bool far = contacts.size() > (std::size_t{1} << 17);
   using F = ContactBatch;
   ContactBatch& hill = scratch.hill;
@@ -808,6 +809,18 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
     ball_moment[a] = Vec3{};
     if (want_stiffness) ball_k_tran_[a] = ball_k_rot_[a] = 0.0;
     const BallKin& ka = kin[a];
+    if (far && a >= kPrefetchBalls) {
+      // The record, force sums and row range of the ball some places down: the pass meets each ball
+      // first as the `a` of its rows, a descending stream (1.01-1.06 x at 100,800 spheres, three
+      // runs of the in-process alternation of `hilldem bench --alternate`, thirteenth session).
+      const std::size_t ahead = a - kPrefetchBalls;
+      const char* record = reinterpret_cast<const char*>(kin + ahead);
+      __builtin_prefetch(record);
+      __builtin_prefetch(record + 64);
+      __builtin_prefetch(ball_force + ahead, 1);
+      __builtin_prefetch(ball_moment + ahead, 1);
+      __builtin_prefetch(first_rows_.data() + ahead);
+    }
     for (std::size_t c = first_rows_[a + 1]; c-- > first_rows_[a];) {
       if (far) {  // (nothing asked for ahead when the rows fit in the caches: see above)
         if (c >= kPrefetchRows) {
