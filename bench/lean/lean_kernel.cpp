@@ -405,6 +405,22 @@ int main(int argc, char** argv) {
       }
     long touching = 0;
     int cnt = 0;
+    // Lane i's 27 fields from the row, its two balls and its history.
+    auto put_lane = [&](int i, std::uint32_t p, std::size_t a, std::uint32_t b, double dx, double dy, double dz,
+                        const Kin& ka, const Kin& kb, const Spin& sa, const Spin& sb,
+                        const History& h) __attribute__((always_inline)) {
+      lane_p[i] = p, lane_a[i] = static_cast<std::uint32_t>(a), lane_b[i] = b;
+      lane[DX][i] = dx, lane[DY][i] = dy, lane[DZ][i] = dz;
+      lane[RA][i] = ka.r, lane[RB][i] = kb.r;
+      lane[VAX][i] = ka.vx, lane[VAY][i] = ka.vy, lane[VAZ][i] = ka.vz;
+      lane[VBX][i] = kb.vx, lane[VBY][i] = kb.vy, lane[VBZ][i] = kb.vz;
+      lane[WAX][i] = sa.wx, lane[WAY][i] = sa.wy, lane[WAZ][i] = sa.wz;
+      lane[WBX][i] = sb.wx, lane[WBY][i] = sb.wy, lane[WBZ][i] = sb.wz;
+      lane[IRA][i] = sa.inv_r, lane[IRB][i] = sb.inv_r, lane[IMA][i] = ka.inv_m, lane[IMB][i] = kb.inv_m;
+      lane[NOX][i] = h.nx, lane[NOY][i] = h.ny, lane[NOZ][i] = h.nz;
+      lane[HX][i] = h.hx, lane[HY][i] = h.hy, lane[HZ][i] = h.hz;
+      if (rowmeta) lane[IRA][i] += 0.0 * (params[p].mu + params[p].damp + params[p].suction + model[p]);
+    };
     for (std::size_t a = 0; a < n; ++a) {
       const Kin& ka = kin[a];
       const Spin& sa = spin[a];
@@ -434,17 +450,7 @@ int main(int argc, char** argv) {
           }
           const Spin& sb = spin[b];
           const int i = cnt;
-          lane_p[i] = p, lane_a[i] = static_cast<std::uint32_t>(a), lane_b[i] = b;
-          lane[DX][i] = dx, lane[DY][i] = dy, lane[DZ][i] = dz;
-          lane[RA][i] = ka.r, lane[RB][i] = kb.r;
-          lane[VAX][i] = ka.vx, lane[VAY][i] = ka.vy, lane[VAZ][i] = ka.vz;
-          lane[VBX][i] = kb.vx, lane[VBY][i] = kb.vy, lane[VBZ][i] = kb.vz;
-          lane[WAX][i] = sa.wx, lane[WAY][i] = sa.wy, lane[WAZ][i] = sa.wz;
-          lane[WBX][i] = sb.wx, lane[WBY][i] = sb.wy, lane[WBZ][i] = sb.wz;
-          lane[IRA][i] = sa.inv_r, lane[IRB][i] = sb.inv_r, lane[IMA][i] = ka.inv_m, lane[IMB][i] = kb.inv_m;
-          lane[NOX][i] = h.nx, lane[NOY][i] = h.ny, lane[NOZ][i] = h.nz;
-          lane[HX][i] = h.hx, lane[HY][i] = h.hy, lane[HZ][i] = h.hz;
-          if (rowmeta) lane[IRA][i] += 0.0 * (params[p].mu + params[p].damp + params[p].suction + model[p]);
+          put_lane(i, p, a, b, dx, dy, dz, ka, kb, sa, sb, h);
           cnt += static_cast<int>(touch);
           touching += touch;
           if (cnt == L) law(cnt), cnt = 0;
@@ -460,17 +466,7 @@ int main(int argc, char** argv) {
         ++touching;
         const Spin& sb = spin[b];
         const int i = cnt++;
-        lane_p[i] = p, lane_a[i] = static_cast<std::uint32_t>(a), lane_b[i] = b;
-        lane[DX][i] = dx, lane[DY][i] = dy, lane[DZ][i] = dz;
-        lane[RA][i] = ka.r, lane[RB][i] = kb.r;
-        lane[VAX][i] = ka.vx, lane[VAY][i] = ka.vy, lane[VAZ][i] = ka.vz;
-        lane[VBX][i] = kb.vx, lane[VBY][i] = kb.vy, lane[VBZ][i] = kb.vz;
-        lane[WAX][i] = sa.wx, lane[WAY][i] = sa.wy, lane[WAZ][i] = sa.wz;
-        lane[WBX][i] = sb.wx, lane[WBY][i] = sb.wy, lane[WBZ][i] = sb.wz;
-        lane[IRA][i] = sa.inv_r, lane[IRB][i] = sb.inv_r, lane[IMA][i] = ka.inv_m, lane[IMB][i] = kb.inv_m;
-        lane[NOX][i] = h.nx, lane[NOY][i] = h.ny, lane[NOZ][i] = h.nz;
-        lane[HX][i] = h.hx, lane[HY][i] = h.hy, lane[HZ][i] = h.hz;
-        if (rowmeta) lane[IRA][i] += 0.0 * (params[p].mu + params[p].damp + params[p].suction + model[p]);
+        put_lane(i, p, a, b, dx, dy, dz, ka, kb, sa, sb, h);
         if (cnt == L) law(cnt), cnt = 0;
       }
     }
