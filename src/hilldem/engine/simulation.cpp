@@ -864,7 +864,8 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
                     image);
         const BallKin& kb = kin[b];
         const double reach = ka.radius + kb.radius + proximity;
-        unsigned fresh = static_cast<unsigned>(!exists) & static_cast<unsigned>(norm2(separation(ka, kb, image, box)) <= reach * reach);
+        const bool near = norm2(separation(ka, kb, image, box)) <= reach * reach;
+        unsigned fresh = static_cast<unsigned>(!exists) & static_cast<unsigned>(near);
         // One branch, taken rarely: the empty asm makes the compiler compute `fresh` whole, where it
         // would otherwise branch on the separation first, which is as unpredictable as `exists`.
         asm("" : "+r"(fresh));
