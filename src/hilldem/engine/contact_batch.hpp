@@ -68,28 +68,22 @@ class ContactBatch {
     row_[size_] = row;
     return size_++;
   }
-  // The same, with the row's two balls (ball-ball lanes: the scatter adds to their sums).
-  std::size_t add(std::uint32_t row, std::uint32_t ball1, std::uint32_t ball2) {
-    ball1_[size_] = ball1;
-    ball2_[size_] = ball2;
-    return add(row);
-  }
-  // The same, with the row's periodic image of ball 2 as well: the force pass fills the lanes' ball
-  // fields (kDx..kWbz, and the hill terms kIr..kCs) from the balls' records at once, when the batch
-  // is run (Simulation::fill_lanes), not row by row.
-  std::size_t add(std::uint32_t row, std::uint32_t ball1, std::uint32_t ball2, std::uint8_t image) {
-    image_[size_] = image;
-    return add(row, ball1, ball2);
-  }
-  // The same, kept only if `keep`: the slot after the last lane is written either way and becomes a
-  // lane only for a row that is a contact, so that the row loop needs no branch on it (see
-  // Simulation::force_block). Only when !full().
+  // A ball-ball lane for row `row`, kept only if `keep`: the slot after the last lane is written either
+  // way and becomes a lane only for a row that is a contact, so that the row loop needs no branch on
+  // it (Simulation::force_block). The row's two balls (the scatter adds to their sums) and the
+  // periodic image of ball 2: the force pass fills the lanes' ball fields (kDx..kWbz, and the hill
+  // terms kIr..kCs) from the balls' records when the batch is run (Simulation::fill_lanes), not row by
+  // row. Only when !full().
   void add_if(bool keep, std::uint32_t row, std::uint32_t ball1, std::uint32_t ball2, std::uint8_t image) {
     image_[size_] = image;
     ball1_[size_] = ball1;
     ball2_[size_] = ball2;
     row_[size_] = row;
     size_ += keep ? 1 : 0;
+  }
+  // The same, always kept.
+  void add(std::uint32_t row, std::uint32_t ball1, std::uint32_t ball2, std::uint8_t image) {
+    add_if(true, row, ball1, ball2, image);
   }
   std::uint8_t image(std::size_t lane) const { return image_[lane]; }
   std::uint32_t ball1(std::size_t lane) const { return ball1_[lane]; }

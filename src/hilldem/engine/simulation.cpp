@@ -771,6 +771,14 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
       crossing.push_back({static_cast<std::uint32_t>(b), force, moment2, k_tran, k_shear, gap});
     }
   };
+  // Whether a ball-ball pair (ball a's record ka, ball b, the row's periodic image) is within reach: a
+  // neighbour pair becomes a contact there (as force_row). Not beyond it, so that a non-finite
+  // separation goes to force_row, which reports it.
+  auto within_reach = [&](const BallKin& ka, std::size_t b, ImageCode image) __attribute__((always_inline)) {
+    const BallKin& kb = kin[b];
+    const double reach = ka.radius + kb.radius + proximity;
+    return !(norm2(separation(ka, kb, image, box)) > reach * reach);
+  };
   // Row c's share (share.force is −F_c: x − (−F) is x + F bit for bit).
   auto add_share = [&](std::size_t c, const RowShare& s) __attribute__((always_inline)) {
     if (!s.ok) bad_row = std::min(bad_row, c);
@@ -862,10 +870,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
         const ImageCode image = contacts.image[c];
         hill.add_if(exists, static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b),
                     image);
-        const BallKin& kb = kin[b];
-        const double reach = ka.radius + kb.radius + proximity;
-        const bool near = norm2(separation(ka, kb, image, box)) <= reach * reach;
-        unsigned fresh = static_cast<unsigned>(!exists) & static_cast<unsigned>(near);
+        unsigned fresh = static_cast<unsigned>(!exists) & static_cast<unsigned>(within_reach(ka, b, image));
         // One branch, taken rarely: the empty asm makes the compiler compute `fresh` whole, where it
         // would otherwise branch on the separation first, which is as unpredictable as `exists`.
         asm("" : "+r"(fresh));
@@ -875,11 +880,8 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
         }
         continue;
       }
-      if (!exists && batched) {  // a neighbour pair: a contact only once within proximity (as force_row)
-        const BallKin& kb = kin[b];
-        const double reach = ka.radius + kb.radius + proximity;
-        if (norm2(separation(ka, kb, contacts.image[c], box)) > reach * reach) continue;  // nothing to either ball
-      }
+      // A neighbour pair beyond reach gives nothing to either ball.
+      if (!exists && batched && !within_reach(ka, b, contacts.image[c])) continue;
       if (!batched || !exists) {
         if (hill.size() > 0) flush(hill);
         if (linear.size() > 0) flush(linear);
