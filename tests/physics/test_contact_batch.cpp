@@ -156,13 +156,15 @@ TEST(HillBatch, SameMotionInAPeriodicBox) {
 
 // The periodic box after `configure` set an engine switch: 300 steps dry (the fast grains collide:
 // new contacts between the batched ones), then 300 wet.
+// (live_refreshes: how often the live rows were made, Simulation::live_row_refreshes.)
 template <class Configure>
-Outcome periodic_wet_run(Configure configure) {
+Outcome periodic_wet_run(Configure configure, std::int64_t* live_refreshes = nullptr) {
   Simulation sim = periodic_cloud();
   configure(sim);
   sim.cycle(300);
   sim.make_wet(20e3, 0.5e-3);
   sim.cycle(300);
+  if (live_refreshes) *live_refreshes = sim.live_row_refreshes();
   return outcome(sim);
 }
 
@@ -195,6 +197,28 @@ TEST(HillBatch, RowsWithOrWithoutTheContactBranchGiveTheSameBits) {
   });
   const Outcome branchy = periodic_wet_run([](Simulation& s) { s.use_branchless_rows = false; });
   expect_same_bits(branchless, branchy);
+}
+
+// The row loop over the live rows (use_live_rows) or over all rows: the pairs left out cannot come
+// within reach before the list is made again, the near pairs that do (new contacts) send their
+// ball through all its rows, so the same contacts are made at the same steps, summed in the same
+// order: the same bits, dry and wet, with the row loop with and without its contact branch. The fast
+// grains make the list be made again often (its slack grows), and make new contacts among the lanes.
+TEST(HillBatch, LiveRowsOrAllRowsGiveTheSameBits) {
+  for (const bool branchless : {true, false}) {
+    auto configure = [branchless](bool live) {
+      return [branchless, live](Simulation& s) {
+        s.use_branchless_rows = branchless;
+        s.branchless_rows_min = 0;
+        s.use_live_rows = live;
+      };
+    };
+    std::int64_t refreshes = 0;
+    const Outcome live = periodic_wet_run([&](Simulation& s) { configure(true)(s); }, &refreshes);
+    const Outcome all = periodic_wet_run(configure(false));
+    expect_same_bits(live, all);
+    EXPECT_GT(refreshes, 10);  // (made again on the way, not only at the neighbour-list rebuilds)
+  }
 }
 
 // Two wet grains pulled apart: the bridge holds, then ruptures at 2 s_cr (Eq. 12), at the same step

@@ -85,7 +85,7 @@ std::int64_t settle_bed(const std::string& in, const std::string& out, double ra
 }
 
 const std::vector<std::string>& alternate_switches() {
-  static const std::vector<std::string> names{"vector-fill", "branchless-rows"};
+  static const std::vector<std::string> names{"vector-fill", "branchless-rows", "live-rows"};
   return names;
 }
 
@@ -96,7 +96,9 @@ bool& switch_of(Simulation& sim, const std::string& name) {
     sim.branchless_rows_min = 0;  // (compared at any size)
     return sim.use_branchless_rows;
   }
-  throw InputError("bench --alternate: unknown switch '" + name + "' (allowed: vector-fill, branchless-rows)");
+  if (name == "live-rows") return sim.use_live_rows;
+  throw InputError("bench --alternate: unknown switch '" + name +
+                   "' (allowed: vector-fill, branchless-rows, live-rows)");
 }
 }  // namespace
 

@@ -19,10 +19,11 @@ struct BedBenchOptions {
   std::int64_t steps = 1000;  // timed steps
   int threads = 0;            // 0 = OpenMP default
   std::size_t block = 0;      // balls per block of the force pass (0: the engine's default); tuning only
-  // An engine switch whose two settings give the same bits ("vector-fill", "branchless-rows"; empty:
-  // none): the timed steps run in blocks of alternate_block steps with the switch off and on in turn,
-  // and the line gives the rate of each and their ratio. This machine's speed swings by 20-40 %
-  // within minutes; two settings timed in turn within one run see the same swings.
+  // An engine switch whose two settings give the same bits ("vector-fill", "branchless-rows",
+  // "live-rows"; empty: none): the timed steps run in blocks of alternate_block steps with the
+  // switch off and on in turn, and the line gives the rate of each and their ratio. This machine's
+  // speed swings by 20-40 % within minutes; two settings timed in turn within one run see the same
+  // swings.
   std::string alternate;
   std::int64_t alternate_block = 20;
 };

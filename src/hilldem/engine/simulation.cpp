@@ -245,17 +245,29 @@ void Simulation::rebuild_if_needed() {
     // Parallel: the maximum does not depend on the order, and any NaN ends the run below.
     const std::size_t n = balls.size();
     double worst = 0.0;
+    // And the largest travel since the live rows were made (refresh_live_rows), while they are.
+    const bool live = live_ready_ && position_at_live_.size() == n;
+    double worst_live = 0.0;
 #pragma omp parallel if (n > kParallelMin)
     {
-      double mine = 0.0;
+      double mine = 0.0, mine_live = 0.0;
 #pragma omp for schedule(static) nowait
       for (std::size_t i = 0; i < n; ++i) {
         const double d2 = norm2(balls.position[i] - position_at_build_[i]);
         if (!(d2 <= mine)) mine = d2;
+        if (live) {
+          const double l2 = norm2(balls.position[i] - position_at_live_[i]);
+          if (!(l2 <= mine_live)) mine_live = l2;
+        }
       }
 #pragma omp critical(hilldem_rebuild_check)
-      if (!(mine <= worst)) worst = mine;
+      {
+        if (!(mine <= worst)) worst = mine;
+        if (!(mine_live <= worst_live)) worst_live = mine_live;
+      }
     }
+    live_travel_ = std::sqrt(worst_live);
+    live_travel_known_ = live;
     if (!std::isfinite(worst)) {
       for (std::size_t i = 0; i < balls.size(); ++i)
         if (!std::isfinite(norm2(balls.position[i])))
@@ -361,6 +373,7 @@ void Simulation::build_row_lists() {
     if (k.kind == ContactKind::BallBall) late_rows_[late_fill[k.b]++] = static_cast<std::uint32_t>(c);
   }
   share_moment_.assign(rows, Vec3{});
+  live_ready_ = false;  // (new rows)
   ball_k_tran_.assign(n, 0.0);
   ball_k_rot_.assign(n, 0.0);
   stiffness_ready_ = false;
@@ -584,6 +597,15 @@ HILLDEM_INLINE Vec3 separation(const Kin& ka, const Kin& kb, ImageCode image, co
   if (image != kNoImage) x2 += image_shift(image, box);
   return x2 - ka.position;
 }
+// Whether a ball-ball pair is within reach (gap ≤ proximity [m]): a neighbour pair becomes a contact
+// there (as force_row). Not beyond it, so that a non-finite separation goes to force_row, which
+// reports it.
+template <class Kin>
+HILLDEM_INLINE bool pair_within_reach(const Kin& ka, const Kin& kb, ImageCode image, const PeriodicBox& box,
+                                      double proximity) {
+  const double reach = ka.radius + kb.radius + proximity;
+  return !(norm2(separation(ka, kb, image, box)) > reach * reach);
+}
 }  // namespace
 
 #if defined(__AVX512F__)
@@ -720,7 +742,7 @@ void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
 
 void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_end, double dt, BlockScratch& scratch,
                              std::vector<CrossShare>& crossing, std::size_t& bad_row, std::int64_t& batched_count,
-                             bool count_contacts) {
+                             bool count_contacts, std::size_t& full_balls) {
   // Rows of balls a0..a1-1 (ball-ball rows, contiguous), from the last ball down and each ball's rows
   // from the last down. Existing hill and linear contacts go through the batches; new contacts and
   // the shear-displacement tracking through force_row(). Each row's share is added to both balls
@@ -751,6 +773,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
   constexpr std::size_t kPrefetchFlags = 128;
   constexpr std::size_t kPrefetchBalls = 8;
   const bool far = contacts.size() > (std::size_t{1} << 17);
+  const bool live = live_now_;  // the rows visited: the live rows (force_pass), or all
   using F = ContactBatch;
   ContactBatch& hill = scratch.hill;
   ContactBatch& linear = scratch.linear;
@@ -771,13 +794,9 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
       crossing.push_back({static_cast<std::uint32_t>(b), force, moment2, k_tran, k_shear, gap});
     }
   };
-  // Whether a ball-ball pair (ball a's record ka, ball b, the row's periodic image) is within reach: a
-  // neighbour pair becomes a contact there (as force_row). Not beyond it, so that a non-finite
-  // separation goes to force_row, which reports it.
+  // Whether a ball-ball pair (ball a's record ka, ball b, the row's periodic image) is within reach.
   auto within_reach = [&](const BallKin& ka, std::size_t b, ImageCode image) __attribute__((always_inline)) {
-    const BallKin& kb = kin[b];
-    const double reach = ka.radius + kb.radius + proximity;
-    return !(norm2(separation(ka, kb, image, box)) > reach * reach);
+    return pair_within_reach(ka, kin[b], image, box, proximity);
   };
   // Row c's share (share.force is −F_c: x − (−F) is x + F bit for bit).
   auto add_share = [&](std::size_t c, const RowShare& s) __attribute__((always_inline)) {
@@ -828,74 +847,123 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
       __builtin_prefetch(ball_force + ahead, 1);
       __builtin_prefetch(ball_moment + ahead, 1);
       __builtin_prefetch(first_rows_.data() + ahead);
+      if (live) {
+        // Its row ranges, those of the ball eight places further (read here next time), and the
+        // records of its near pairs' second balls.
+        __builtin_prefetch(live_first_.data() + ahead);
+        if (ahead >= kPrefetchBalls) __builtin_prefetch(near_first_.data() + ahead - kPrefetchBalls);
+        for (std::size_t k = near_first_[ahead]; k < near_first_[ahead + 1]; ++k) {
+          const char* near = reinterpret_cast<const char*>(kin + keys[near_rows_[k]].b);
+          __builtin_prefetch(near);
+          __builtin_prefetch(near + 64);
+        }
+      }
     }
-    for (std::size_t c = first_rows_[a + 1]; c-- > first_rows_[a];) {
-      if (far) {  // (nothing asked for ahead when the rows fit in the caches: see above)
-        if (c >= kPrefetchRows) {
-          // The ball record of a neighbour some rows on, and its force sums: the neighbours in the layer
-          // above a ball are a whole layer away in memory, and the hardware prefetcher misses them
-          // (perf annotate).
-          const std::size_t ahead_ball = keys[c - kPrefetchRows].b;
-          const char* ahead = reinterpret_cast<const char*>(kin + ahead_ball);
-          __builtin_prefetch(ahead);
-          __builtin_prefetch(ahead + 64);
-          __builtin_prefetch(ball_force + ahead_ball, 1);
-          __builtin_prefetch(ball_moment + ahead_ball, 1);
+    // Ball a's rows from the last down: k1 − 1 down to k0 of the row sequence row_at, its live rows
+    // (live_rows) or all of its rows.
+    auto run_rows = [&](std::size_t k1, std::size_t k0, auto row_at, bool live_rows) __attribute__((always_inline)) {
+      for (std::size_t k = k1; k-- > k0;) {
+        const std::size_t c = row_at(k);
+        if (far) {  // (nothing asked for ahead when the rows fit in the caches: see above)
+          if (k >= kPrefetchRows) {
+            // The ball record of a neighbour some rows on, and its force sums: the neighbours in the layer
+            // above a ball are a whole layer away in memory, and the hardware prefetcher misses them
+            // (perf annotate).
+            const std::size_t ahead_ball = keys[row_at(k - kPrefetchRows)].b;
+            const char* ahead = reinterpret_cast<const char*>(kin + ahead_ball);
+            __builtin_prefetch(ahead);
+            __builtin_prefetch(ahead + 64);
+            __builtin_prefetch(ball_force + ahead_ball, 1);
+            __builtin_prefetch(ball_moment + ahead_ball, 1);
+          }
+          if (k >= kPrefetchColumns) {  // the history and the parameters
+            const std::size_t r = row_at(k - kPrefetchColumns);
+            __builtin_prefetch(contacts.normal.data() + r, 1);
+            __builtin_prefetch(contacts.shear_state.data() + r, 1);
+            __builtin_prefetch(row_hill_set_.data() + r);
+          }
+          if (k >= kPrefetchFlags) {  // the byte columns, and the keys (12 B) half as far
+            const std::size_t r = row_at(k - kPrefetchFlags);
+            __builtin_prefetch(contacts.image.data() + r);
+            __builtin_prefetch(contacts.exists.data() + r);
+            __builtin_prefetch(contacts.model.data() + r);
+            __builtin_prefetch(contacts.moisture.data() + r);
+            __builtin_prefetch(keys + row_at(k - kPrefetchFlags / 2));
+          }
         }
-        if (c >= kPrefetchColumns) {  // the history and the parameters
-          const std::size_t r = c - kPrefetchColumns;
-          __builtin_prefetch(contacts.normal.data() + r, 1);
-          __builtin_prefetch(contacts.shear_state.data() + r, 1);
-          __builtin_prefetch(row_hill_set_.data() + r);
+        const std::size_t b = keys[c].b;
+        const bool exists = contacts.exists[c];
+        if (live_rows && contacts.model[c] == ModelKind::Hill) {
+          // A live hill row: a contact but for those deleted since the list was made, so the branch
+          // on it is taken rarely. Its lane is kept if it is a contact; a pair within reach again (a
+          // new contact) goes through force_row in row order.
+          if (linear.size() > 0) flush(linear);
+          if (hill.full()) flush(hill);
+          const ImageCode image = contacts.image[c];
+          hill.add_if(exists, static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(a),
+                      static_cast<std::uint32_t>(b), image);
+          if (!exists) [[unlikely]] {
+            if (within_reach(ka, b, image)) {
+              if (hill.size() > 0) flush(hill);
+              add_share(c, force_row(c, dt));
+            }
+          }
+          continue;
         }
-        if (c >= kPrefetchFlags) {  // the byte columns, and the keys (12 B) half as far
-          const std::size_t r = c - kPrefetchFlags;
-          __builtin_prefetch(contacts.image.data() + r);
-          __builtin_prefetch(contacts.exists.data() + r);
-          __builtin_prefetch(contacts.model.data() + r);
-          __builtin_prefetch(contacts.moisture.data() + r);
-          __builtin_prefetch(keys + r + kPrefetchFlags / 2);
+        if (branchless && contacts.model[c] == ModelKind::Hill) {
+          // A hill row, contact or neighbour pair, without a branch on which it is: whether a row is a
+          // contact follows no pattern the branch predictor can learn once the rows outgrow its
+          // history (≈ 45 % of the bench bed's rows are neighbour pairs). The row always takes the
+          // next lane's slot, which becomes a lane only if it is a contact, and its separation is
+          // checked either way; only a neighbour pair within reach (a new contact: rare) branches.
+          if (linear.size() > 0) flush(linear);
+          if (hill.full()) flush(hill);
+          const ImageCode image = contacts.image[c];
+          hill.add_if(exists, static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(a),
+                      static_cast<std::uint32_t>(b), image);
+          unsigned fresh = static_cast<unsigned>(!exists) & static_cast<unsigned>(within_reach(ka, b, image));
+          // One branch, taken rarely: the empty asm makes the compiler compute `fresh` whole, where it
+          // would otherwise branch on the separation first, which is as unpredictable as `exists`.
+          asm("" : "+r"(fresh));
+          if (fresh != 0) [[unlikely]] {  // a contact from now on (force_row), in row order
+            if (hill.size() > 0) flush(hill);
+            add_share(c, force_row(c, dt));
+          }
+          continue;
         }
-      }
-      const std::size_t b = keys[c].b;
-      const bool exists = contacts.exists[c];
-      if (branchless && contacts.model[c] == ModelKind::Hill) {
-        // A hill row, contact or neighbour pair, without a branch on which it is: whether a row is a
-        // contact follows no pattern the branch predictor can learn once the rows outgrow its
-        // history (≈ 45 % of the bench bed's rows are neighbour pairs). The row always takes the
-        // next lane's slot, which becomes a lane only if it is a contact, and its separation is
-        // checked either way; only a neighbour pair within reach (a new contact: rare) branches.
-        if (linear.size() > 0) flush(linear);
-        if (hill.full()) flush(hill);
-        const ImageCode image = contacts.image[c];
-        hill.add_if(exists, static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b),
-                    image);
-        unsigned fresh = static_cast<unsigned>(!exists) & static_cast<unsigned>(within_reach(ka, b, image));
-        // One branch, taken rarely: the empty asm makes the compiler compute `fresh` whole, where it
-        // would otherwise branch on the separation first, which is as unpredictable as `exists`.
-        asm("" : "+r"(fresh));
-        if (fresh != 0) [[unlikely]] {  // a contact from now on (force_row), in row order
+        // A neighbour pair beyond reach gives nothing to either ball.
+        if (!exists && batched && !within_reach(ka, b, contacts.image[c])) continue;
+        if (!batched || !exists) {
           if (hill.size() > 0) flush(hill);
+          if (linear.size() > 0) flush(linear);
           add_share(c, force_row(c, dt));
+          continue;
         }
-        continue;
+        const bool is_hill = contacts.model[c] == ModelKind::Hill;
+        ContactBatch& batch = is_hill ? hill : linear;
+        ContactBatch& other = is_hill ? linear : hill;
+        if (other.size() > 0) flush(other);
+        if (batch.full()) flush(batch);
+        // The lane's inputs are read when the batch runs (fill_lanes).
+        batch.add(static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b),
+                  contacts.image[c]);
       }
-      // A neighbour pair beyond reach gives nothing to either ball.
-      if (!exists && batched && !within_reach(ka, b, contacts.image[c])) continue;
-      if (!batched || !exists) {
-        if (hill.size() > 0) flush(hill);
-        if (linear.size() > 0) flush(linear);
-        add_share(c, force_row(c, dt));
-        continue;
+    };
+    // A ball with a near pair that is a contact (made since the list) or within reach now (to be
+    // made) visits all its rows: the pair is not among its live rows.
+    bool full = false;
+    if (live) {
+      for (std::size_t k = near_first_[a]; k < near_first_[a + 1]; ++k) {
+        const std::size_t c = near_rows_[k];
+        full |= contacts.exists[c] || within_reach(ka, keys[c].b, contacts.image[c]);
       }
-      const bool is_hill = contacts.model[c] == ModelKind::Hill;
-      ContactBatch& batch = is_hill ? hill : linear;
-      ContactBatch& other = is_hill ? linear : hill;
-      if (other.size() > 0) flush(other);
-      if (batch.full()) flush(batch);
-      // The lane's inputs are read when the batch runs (fill_lanes).
-      batch.add(static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b),
-                contacts.image[c]);
+      full_balls += full;
+    }
+    if (live && !full) {
+      const std::uint32_t* rows = live_rows_.data();
+      run_rows(live_first_[a + 1], live_first_[a], [rows](std::size_t k) -> std::size_t { return rows[k]; }, true);
+    } else {
+      run_rows(first_rows_[a + 1], first_rows_[a], [](std::size_t k) { return k; }, false);
     }
   }
   if (hill.size() > 0) flush(hill);
@@ -997,6 +1065,70 @@ void Simulation::split_work(int threads) {
   }
 }
 
+void Simulation::refresh_live_rows() {
+  // The slack s: the list is made again when any ball has moved more than s since; it holds the
+  // neighbour pairs within proximity + 2 s. A list that lasted fewer than kLiveShort passes doubles
+  // it (fast balls: fewer remakes, more pairs checked), one that lasted more than kLiveLong halves it
+  // (slow balls), between a thousandth and a quarter of the skin. The list changes no result, only
+  // how much the row loop visits; so neither does s.
+  constexpr std::int64_t kLiveShort = 25, kLiveLong = 400;
+  const double skin_now = skin();
+  const std::int64_t lasted = live_passes_;
+  if (!(live_slack_ > 0.0) || live_slack_ > 0.25 * skin_now) live_slack_ = 0.002 * skin_now;
+  else if (live_ready_ && lasted < kLiveShort) live_slack_ = std::min(2.0 * live_slack_, 0.25 * skin_now);
+  else if (live_ready_ && lasted > kLiveLong) live_slack_ = std::max(0.5 * live_slack_, 0.001 * skin_now);
+  live_passes_ = 0;
+  const std::size_t n = balls.size();
+  const double proximity = settings.proximity;
+  const double slack = live_slack_;
+  // Each ball-ball row: live (a contact, or not a hill row), near (a hill neighbour pair within
+  // proximity + 2 s, with a margin of 1e-9 of the radii, far above the rounding of the distances and
+  // of the travel), or neither.
+  enum : std::uint8_t { kNeither = 0, kLive = 1, kNear = 2 };
+  auto kind_of = [&](std::size_t c) -> std::uint8_t {
+    if (contacts.exists[c] || contacts.model[c] != ModelKind::Hill) return kLive;
+    const ContactKey& k = contacts.key[c];
+    Vec3 xb = balls.position[k.b];
+    if (contacts.image[c] != kNoImage) xb += image_shift(contacts.image[c], settings.box);
+    const double radii = balls.radius[k.a] + balls.radius[k.b];
+    const double reach = (radii + proximity + 2.0 * slack) * (1.0 + 1e-9);
+    return norm2(xb - balls.position[k.a]) > reach * reach ? kNeither : kNear;
+  };
+  std::vector<std::uint8_t> kind(contacts.size(), kNeither);
+  live_first_.assign(n + 1, 0);
+  near_first_.assign(n + 1, 0);
+  std::vector<std::uint32_t>& near_first = near_first_;
+#pragma omp parallel for schedule(static) if (n > kParallelMin)
+  for (std::size_t a = 0; a < n; ++a) {
+    std::uint32_t live = 0, near = 0;
+    for (std::size_t c = first_rows_[a]; c < first_rows_[a + 1]; ++c) {
+      kind[c] = kind_of(c);
+      live += kind[c] == kLive;
+      near += kind[c] == kNear;
+    }
+    live_first_[a + 1] = live;
+    near_first[a + 1] = near;
+  }
+  for (std::size_t a = 0; a < n; ++a) {
+    live_first_[a + 1] += live_first_[a];
+    near_first[a + 1] += near_first[a];
+  }
+  live_rows_.resize(live_first_[n]);
+  near_rows_.resize(near_first[n]);
+#pragma omp parallel for schedule(static) if (n > kParallelMin)
+  for (std::size_t a = 0; a < n; ++a) {
+    std::uint32_t l = live_first_[a], m = near_first[a];
+    for (std::size_t c = first_rows_[a]; c < first_rows_[a + 1]; ++c) {
+      if (kind[c] == kLive) live_rows_[l++] = static_cast<std::uint32_t>(c);
+      if (kind[c] == kNear) near_rows_[m++] = static_cast<std::uint32_t>(c);
+    }
+  }
+  position_at_live_ = balls.position;
+  live_rows_of_ = contacts.size();
+  live_ready_ = true;
+  ++live_refreshes_;
+}
+
 void Simulation::force_pass(double dt) {
   const std::size_t rows = contacts.size();
   const std::size_t n = balls.size();
@@ -1015,7 +1147,16 @@ void Simulation::force_pass(double dt) {
   ball_kin_.resize(n);
   const std::size_t wall_rows = wall_rows_.size();
   ball_contacts_.resize(n);
-#pragma omp parallel reduction(min : bad_row) reduction(+ : batched) if (n > kParallelMin)
+  // The live rows (use_live_rows), made again when a ball may have moved more than the slack since
+  // they were (rebuild_if_needed measured it), or the rows or their models may have changed. (A
+  // contact made since, in any pass, was a live or a near row: the others were too far apart to
+  // touch.)
+  live_now_ = use_live_rows && use_batched_kernel && !settings.track_shear_displacement;
+  if (!terms_ready || live_rows_of_ != rows) live_ready_ = false;
+  if (live_now_ && !(live_ready_ && live_travel_known_ && live_travel_ <= live_slack_)) refresh_live_rows();
+  live_travel_known_ = false;  // (measured again before the next pass)
+  std::size_t full_balls = 0;  // balls that visited all their rows (force_block)
+#pragma omp parallel reduction(min : bad_row) reduction(+ : batched, full_balls) if (n > kParallelMin)
   {
     // What the pair loop reads of each ball, in one record (two cache lines): one memory stream per
     // neighbourhood instead of one per column. The hill terms (four divisions per ball) only when the
@@ -1057,7 +1198,8 @@ void Simulation::force_pass(double dt) {
     const bool count_contacts = omp_get_num_threads() > 1;
     if (last > first)
       for (std::size_t a = first + (last - first - 1) / block * block;; a -= block) {
-        force_block(a, std::min(last, a + block), last, dt, *scratch, crossing, bad_row, batched, count_contacts);
+        force_block(a, std::min(last, a + block), last, dt, *scratch, crossing, bad_row, batched, count_contacts,
+                    full_balls);
         if (a == first) break;
       }
     // The wall rows, shared out among the threads whatever their number (no thread waits for
@@ -1072,6 +1214,10 @@ void Simulation::force_pass(double dt) {
   }
   batched_rows_ = batched;
   body_terms_ready_ = true;
+  // Many balls visiting all their rows (their new contacts are not live rows): the list is made
+  // again before the next pass.
+  if (live_now_ && full_balls > 64 + near_rows_.size() / 64) live_ready_ = false;
+  ++live_passes_;
   if (bad_row < rows) {
     const ContactKey& key = contacts.key[bad_row];
     std::ostringstream msg;

@@ -124,6 +124,16 @@ class Simulation {
   // does, and the loop without the branch is 1.14 x faster (docs/performance.md, thirteenth session).
   bool use_branchless_rows = true;
   std::size_t branchless_rows_min = std::size_t{1} << 15;
+  // The row loop visits only the live rows: the contacts, the rows of other models than hill, and
+  // the neighbour pairs that were within proximity + 2 s when the list was made; it is made again
+  // when any ball has moved more than s since (the slack s adapts to how fast the balls move,
+  // refresh_live_rows). A pair outside the list cannot have come within reach, and gives nothing,
+  // so the sums and their order are those of all rows: the same bits either way (test
+  // HillBatch.LiveRowsOrAllRowsGiveTheSameBits). In a settled bed ≈ 40 % of the rows are neighbour
+  // pairs apart, which the loop then skips (docs/performance.md, fourteenth session).
+  bool use_live_rows = true;
+  // How often the live rows were made.
+  std::int64_t live_row_refreshes() const { return live_refreshes_; }
   // Balls per block of the force pass (a block's contacts fill the batches together; blocks are
   // the unit of work of the threads). A tuning knob only: results do not depend on it (the batches
   // pad their lanes, ContactBatch::pad_lanes). 128: docs/performance.md.
@@ -240,10 +250,11 @@ class Simulation {
   // The rows of balls a0..a1-1 (ball-ball), summed into both balls (see force_pass for the order);
   // a second ball at or beyond range_end (outside this thread's range) gets its share in `crossing`.
   // bad_row: the lowest row with a non-finite force; batched: + the rows that went through a batch.
-  // count_contacts: also count each ball's contacts for the next pass's split_work.
+  // count_contacts: also count each ball's contacts for the next pass's split_work. full_balls: + the
+  // balls that visited all their rows, not only their live rows.
   void force_block(std::size_t a0, std::size_t a1, std::size_t range_end, double dt, BlockScratch& scratch,
                    std::vector<CrossShare>& crossing, std::size_t& bad_row, std::int64_t& batched,
-                   bool count_contacts);
+                   bool count_contacts, std::size_t& full_balls);
   // The wall rows wall_rows_[k0..k1): existing linear contacts that touch their wall through a linear
   // batch (the wall's geometry given), the rest row by row (force_row). Each row's results go to its
   // columns and share_moment_; collect_forces() sums them in row order, so the batches need no order.
@@ -319,6 +330,27 @@ class Simulation {
   bool hill_sets_stale_ = true;  // (set by create_contact from the pass's threads: std::atomic_ref)
   void refresh_param_sets();
   std::vector<double> scaled_mass_, scaled_inertia_;  // density scaling [kg], [kg m²]
+  // The live rows (use_live_rows): per ball (live_first_, as first_rows_), in row order, its
+  // ball-ball rows that were live when the list was made (refresh_live_rows), at the positions
+  // position_at_live_ [m]. While no ball has moved more than live_slack_ [m] since, a pair outside
+  // the list is still beyond proximity, and new contacts come only from live rows.
+  std::vector<std::uint32_t> live_rows_;
+  std::vector<std::uint32_t> live_first_;
+  // The near rows: per ball (near_first_), in row order, its hill neighbour pairs within proximity +
+  // 2 live_slack_ when the list was made. A ball with one that is a contact or within reach visits
+  // all its rows (force_block).
+  std::vector<std::uint32_t> near_rows_;
+  std::vector<std::uint32_t> near_first_;
+  std::vector<Vec3> position_at_live_;
+  double live_slack_ = 0.0;
+  std::size_t live_rows_of_ = 0;   // rows when the list was made
+  std::int64_t live_passes_ = 0;   // force passes since
+  std::int64_t live_refreshes_ = 0;
+  bool live_ready_ = false;
+  bool live_now_ = false;          // this force pass visits the live rows
+  double live_travel_ = 0.0;       // [m] the largest travel of a ball since the list (rebuild_if_needed)
+  bool live_travel_known_ = false; // measured for this pass
+  void refresh_live_rows();
 };
 
 }  // namespace hilldem
