@@ -893,39 +893,31 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
         }
         const std::size_t b = keys[c].b;
         const bool exists = contacts.exists[c];
-        if (live_rows && contacts.model[c] == ModelKind::Hill) {
-          // A live hill row: a contact but for those deleted since the list was made, so the branch
-          // on it is taken rarely. Its lane is kept if it is a contact; a pair within reach again (a
-          // new contact) goes through force_row in row order.
+        if ((live_rows || branchless) && contacts.model[c] == ModelKind::Hill) {
+          // A hill row, contact or neighbour pair, without a branch on which it is: the row always
+          // takes the next lane's slot, which becomes a lane only if it is a contact. Only a pair
+          // within reach that is no contact yet (a new one: rare) branches, to force_row in row order.
           if (linear.size() > 0) flush(linear);
           if (hill.full()) flush(hill);
           const ImageCode image = contacts.image[c];
           hill.add_if(exists, static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(a),
                       static_cast<std::uint32_t>(b), image);
-          if (!exists) [[unlikely]] {
-            if (within_reach(ka, b, image)) {
-              if (hill.size() > 0) flush(hill);
-              add_share(c, force_row(c, dt));
-            }
+          bool fresh;
+          if (live_rows) {
+            // A live row is a contact but for those deleted since the list was made, so the branch
+            // on `exists` is taken rarely, and the balls' records are read only then.
+            fresh = !exists && within_reach(ka, b, image);
+          } else {
+            // All rows (branchless): whether a row is a contact follows no pattern the branch
+            // predictor can learn once the rows outgrow its history (≈ 45 % of the bench bed's rows
+            // are neighbour pairs), so the separation is checked either way. The empty asm makes the
+            // compiler compute `near` whole, where it would otherwise branch on the separation first,
+            // which is as unpredictable as `exists`.
+            unsigned near = static_cast<unsigned>(!exists) & static_cast<unsigned>(within_reach(ka, b, image));
+            asm("" : "+r"(near));
+            fresh = near != 0;
           }
-          continue;
-        }
-        if (branchless && contacts.model[c] == ModelKind::Hill) {
-          // A hill row, contact or neighbour pair, without a branch on which it is: whether a row is a
-          // contact follows no pattern the branch predictor can learn once the rows outgrow its
-          // history (≈ 45 % of the bench bed's rows are neighbour pairs). The row always takes the
-          // next lane's slot, which becomes a lane only if it is a contact, and its separation is
-          // checked either way; only a neighbour pair within reach (a new contact: rare) branches.
-          if (linear.size() > 0) flush(linear);
-          if (hill.full()) flush(hill);
-          const ImageCode image = contacts.image[c];
-          hill.add_if(exists, static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(a),
-                      static_cast<std::uint32_t>(b), image);
-          unsigned fresh = static_cast<unsigned>(!exists) & static_cast<unsigned>(within_reach(ka, b, image));
-          // One branch, taken rarely: the empty asm makes the compiler compute `fresh` whole, where it
-          // would otherwise branch on the separation first, which is as unpredictable as `exists`.
-          asm("" : "+r"(fresh));
-          if (fresh != 0) [[unlikely]] {  // a contact from now on (force_row), in row order
+          if (fresh) [[unlikely]] {  // a contact from now on (force_row), in row order
             if (hill.size() > 0) flush(hill);
             add_share(c, force_row(c, dt));
           }
