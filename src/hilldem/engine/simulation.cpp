@@ -1116,6 +1116,7 @@ void Simulation::refresh_live_rows() {
     }
   }
   position_at_live_ = balls.position;
+  live_proximity_ = settings.proximity;
   live_rows_of_ = contacts.size();
   live_ready_ = true;
   ++live_refreshes_;
@@ -1140,11 +1141,12 @@ void Simulation::force_pass(double dt) {
   const std::size_t wall_rows = wall_rows_.size();
   ball_contacts_.resize(n);
   // The live rows (use_live_rows), made again when a ball may have moved more than the slack since
-  // they were (rebuild_if_needed measured it), or the rows or their models may have changed. (A
+  // they were (rebuild_if_needed measured it), or the rows, their models or the proximity may have
+  // changed. (A
   // contact made since, in any pass, was a live or a near row: the others were too far apart to
   // touch.)
   live_now_ = use_live_rows && use_batched_kernel && !settings.track_shear_displacement;
-  if (!terms_ready || live_rows_of_ != rows) live_ready_ = false;
+  if (!terms_ready || live_rows_of_ != rows || !(live_proximity_ == settings.proximity)) live_ready_ = false;
   if (live_now_ && !(live_ready_ && live_travel_known_ && live_travel_ <= live_slack_)) refresh_live_rows();
   live_travel_known_ = false;  // (measured again before the next pass)
   std::size_t full_balls = 0;  // balls that visited all their rows (force_block)

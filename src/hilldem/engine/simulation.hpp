@@ -124,13 +124,14 @@ class Simulation {
   // does, and the loop without the branch is 1.14 x faster (docs/performance.md, thirteenth session).
   bool use_branchless_rows = true;
   std::size_t branchless_rows_min = std::size_t{1} << 15;
-  // The row loop visits only the live rows: the contacts, the rows of other models than hill, and
-  // the neighbour pairs that were within proximity + 2 s when the list was made; it is made again
-  // when any ball has moved more than s since (the slack s adapts to how fast the balls move,
-  // refresh_live_rows). A pair outside the list cannot have come within reach, and gives nothing,
-  // so the sums and their order are those of all rows: the same bits either way (test
-  // HillBatch.LiveRowsOrAllRowsGiveTheSameBits). In a settled bed ≈ 40 % of the rows are neighbour
-  // pairs apart, which the loop then skips (docs/performance.md, fourteenth session).
+  // The row loop visits only the live rows: the contacts and the rows of other models than hill,
+  // when the lists were made. A ball whose near rows (the hill neighbour pairs within proximity + 2 s
+  // then) hold a contact or a pair within reach visits all its rows. The lists are made again when
+  // any ball has moved more than s since (the slack s adapts to how fast the balls move,
+  // refresh_live_rows), so a pair on neither list cannot have come within reach, and gives nothing:
+  // the sums and their order are those of all rows, the same bits either way (test
+  // HillBatch.LiveRowsOrAllRowsGiveTheSameBits). In the settled bench bed ≈ 40 % of the rows are on
+  // neither list, and the loop skips them (docs/performance.md, fourteenth session).
   bool use_live_rows = true;
   // How often the live rows were made.
   std::int64_t live_row_refreshes() const { return live_refreshes_; }
@@ -331,9 +332,9 @@ class Simulation {
   void refresh_param_sets();
   std::vector<double> scaled_mass_, scaled_inertia_;  // density scaling [kg], [kg m²]
   // The live rows (use_live_rows): per ball (live_first_, as first_rows_), in row order, its
-  // ball-ball rows that were live when the list was made (refresh_live_rows), at the positions
-  // position_at_live_ [m]. While no ball has moved more than live_slack_ [m] since, a pair outside
-  // the list is still beyond proximity, and new contacts come only from live rows.
+  // ball-ball rows that were live when the lists were made (refresh_live_rows), at the positions
+  // position_at_live_ [m]. While no ball has moved more than live_slack_ [m] since, a pair on
+  // neither list is still beyond proximity, so new contacts come only from live or near rows.
   std::vector<std::uint32_t> live_rows_;
   std::vector<std::uint32_t> live_first_;
   // The near rows: per ball (near_first_), in row order, its hill neighbour pairs within proximity +
@@ -344,6 +345,7 @@ class Simulation {
   std::vector<Vec3> position_at_live_;
   double live_slack_ = 0.0;
   std::size_t live_rows_of_ = 0;   // rows when the list was made
+  double live_proximity_ = 0.0;    // [m] the proximity then
   std::int64_t live_passes_ = 0;   // force passes since
   std::int64_t live_refreshes_ = 0;
   bool live_ready_ = false;
