@@ -188,6 +188,22 @@ TEST(Threads, OneAndTwoThreadsGiveBitwiseIdenticalResults) {
   EXPECT_EQ(differing_balls(one, two), 0u);
 }
 
+// Two threads sharing the work unequally (as the force pass does when one core runs slower,
+// Simulation::use_speed_split): each thread's range of balls changes, the bits do not.
+TEST(Threads, UnequalSharesOfTheWorkGiveTheSameBits) {
+  auto run = [](std::vector<double> shares) {
+    omp_set_num_threads(shares.empty() ? 1 : static_cast<int>(shares.size()));
+    Simulation sim = wet_box_4000();
+    sim.thread_shares = shares;
+    sim.cycle(60);
+    omp_set_num_threads(omp_get_num_procs());
+    return std::make_pair(sim.balls.position, sim.balls.spin);
+  };
+  const auto one = run({});
+  EXPECT_EQ(differing_balls(one, run({0.15, 0.85})), 0u);
+  EXPECT_EQ(differing_balls(one, run({0.85, 0.15})), 0u);
+}
+
 // Three threads: the force pass cuts the balls into three ranges of equal work (not of equal numbers
 // of balls, and not at block boundaries of the one-thread run) and shares the wall rows out three
 // ways; still the same bits as one thread.

@@ -85,7 +85,7 @@ std::int64_t settle_bed(const std::string& in, const std::string& out, double ra
 }
 
 const std::vector<std::string>& alternate_switches() {
-  static const std::vector<std::string> names{"vector-fill", "branchless-rows", "live-rows"};
+  static const std::vector<std::string> names{"vector-fill", "branchless-rows", "live-rows", "speed-split"};
   return names;
 }
 
@@ -97,8 +97,9 @@ bool& switch_of(Simulation& sim, const std::string& name) {
     return sim.use_branchless_rows;
   }
   if (name == "live-rows") return sim.use_live_rows;
+  if (name == "speed-split") return sim.use_speed_split;
   throw InputError("bench --alternate: unknown switch '" + name +
-                   "' (allowed: vector-fill, branchless-rows, live-rows)");
+                   "' (allowed: vector-fill, branchless-rows, live-rows, speed-split)");
 }
 }  // namespace
 

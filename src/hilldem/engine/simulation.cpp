@@ -1034,6 +1034,34 @@ void Simulation::wall_block(std::size_t k0, std::size_t k1, double dt, BlockScra
   if (batch.size() > 0) flush();
 }
 
+bool Simulation::balance_speeds() {
+  // Each thread's speed over the passes since the split: its work (split_work's units) over its time
+  // in the blocks [s]. The cores of a shared machine run at different speeds (here one of the two
+  // often runs 1.3 x slower than the other, which one changing from run to run), and with equal work
+  // the faster thread waits for the slower at the end of every pass. Shares of the work in
+  // proportion to the speeds, half way from the last shares (the speeds are noisy); a new split only
+  // if a share moved by more than 1 %. Which balls a thread sums changes no result (force_pass).
+  const std::size_t threads = thread_share_.size();
+  if (!use_speed_split || !thread_shares.empty() || threads < 2 || thread_busy_.size() != threads || work_start_.size() != threads + 1 ||
+      work_prefix_.size() != balls.size() + 1)
+    return false;
+  std::vector<double> speed(threads);
+  double total = 0.0;
+  for (std::size_t t = 0; t < threads; ++t) {
+    const double work = static_cast<double>(work_prefix_[work_start_[t + 1]] - work_prefix_[work_start_[t]]);
+    if (!(thread_busy_[t] > 0.0) || !(work > 0.0)) return false;
+    speed[t] = work / thread_busy_[t];
+    total += speed[t];
+  }
+  bool moved = false;
+  for (std::size_t t = 0; t < threads; ++t) {
+    const double share = 0.5 * thread_share_[t] + 0.5 * speed[t] / total;
+    moved |= std::abs(share - thread_share_[t]) > 0.01;
+    thread_share_[t] = share;
+  }
+  return moved;
+}
+
 void Simulation::split_work(int threads) {
   // Work of ball i in the pass, in units of a neighbour row that is not a contact: its rows, three
   // more for each that was a contact in the last pass (gather, law and scatter), and two for the
@@ -1051,8 +1079,20 @@ void Simulation::split_work(int threads) {
   prefix[0] = 0;
   for (std::size_t i = 0; i < n; ++i)
     prefix[i + 1] = prefix[i] + 2 + (first_rows_[i + 1] - first_rows_[i]) + (have_counts ? 3 * ball_contacts_[i] : 0);
-  for (int t = 1; t < threads; ++t) {
-    const std::uint64_t target = prefix[n] * static_cast<std::uint64_t>(t) / static_cast<std::uint64_t>(threads);
+  // Thread t's share of the work: given (thread_shares), equal, or in proportion to the threads'
+  // speeds (balance_speeds).
+  const auto count = static_cast<std::size_t>(threads);
+  if (thread_shares.size() == count) {
+    const double sum = std::accumulate(thread_shares.begin(), thread_shares.end(), 0.0);
+    thread_share_.resize(count);
+    for (std::size_t t = 0; t < count; ++t) thread_share_[t] = sum > 0.0 ? std::max(thread_shares[t], 0.0) / sum : 1.0 / threads;
+  } else if (thread_share_.size() != count || !use_speed_split) {
+    thread_share_.assign(count, 1.0 / threads);
+  }
+  double before = 0.0;
+  for (std::size_t t = 1; t < count; ++t) {
+    before += thread_share_[t - 1];
+    const auto target = static_cast<std::uint64_t>(static_cast<double>(prefix[n]) * std::min(before, 1.0));
     work_start_[t] = static_cast<std::size_t>(std::lower_bound(prefix.begin(), prefix.end(), target) - prefix.begin());
   }
 }
@@ -1174,13 +1214,20 @@ void Simulation::force_pass(double dt) {
     {
       // The split is a serial pass over the balls (≈ 2 % of a two-thread step at 100,800 balls) and
       // moves slowly with the contacts; it changes no result, so it is redone only when the rows or
-      // the thread count changed, or every kSplitEvery passes.
+      // the thread count changed, every kSplitEvery passes, or when the threads' speeds moved their
+      // shares (balance_speeds, every kSpeedEvery passes).
       const auto threads = static_cast<std::size_t>(omp_get_num_threads());
-      if (work_start_.size() != threads + 1 || work_start_.back() != n || split_rows_ != rows ||
-          ++split_age_ >= kSplitEvery) {
+      bool resplit = work_start_.size() != threads + 1 || work_start_.back() != n || split_rows_ != rows ||
+                     thread_share_.size() != threads || ++split_age_ >= kSplitEvery;
+      if (!resplit && ++speed_age_ >= kSpeedEvery) resplit = balance_speeds();
+      if (resplit) {
         split_work(omp_get_num_threads());
         split_rows_ = rows;
         split_age_ = 0;
+      }
+      if (resplit || speed_age_ >= kSpeedEvery) {  // the speeds measured afresh
+        thread_busy_.assign(threads, 0.0);
+        speed_age_ = 0;
       }
       crossing_.resize(threads);
     }
@@ -1190,12 +1237,14 @@ void Simulation::force_pass(double dt) {
     crossing.clear();
     // One thread needs no split, nor the counts it is made from (3 % of a step in cache).
     const bool count_contacts = omp_get_num_threads() > 1;
+    const double busy_from = count_contacts ? omp_get_wtime() : 0.0;
     if (last > first)
       for (std::size_t a = first + (last - first - 1) / block * block;; a -= block) {
         force_block(a, std::min(last, a + block), last, dt, *scratch, crossing, bad_row, batched, count_contacts,
                     full_balls);
         if (a == first) break;
       }
+    if (count_contacts) thread_busy_[t] += omp_get_wtime() - busy_from;  // [s] (balance_speeds)
     // The wall rows, shared out among the threads whatever their number (no thread waits for
     // another to do them alone), each thread's part in batches (wall_block). Each row's result
     // depends on no other row, nor on the batch it falls into (the lanes are padded), so the split

@@ -135,6 +135,12 @@ class Simulation {
   bool use_live_rows = true;
   // How often the live rows were made.
   std::int64_t live_row_refreshes() const { return live_refreshes_; }
+  // Threads share the balls of the force pass in proportion to their measured speeds (the cores of a
+  // shared machine do not run equally fast); false: equal work. Results do not depend on the shares.
+  bool use_speed_split = true;
+  // Given shares of the work per thread (one per thread, normalised) instead: for tests, and for cores
+  // of known speeds. Empty: measured (use_speed_split) or equal.
+  std::vector<double> thread_shares;
   // Balls per block of the force pass (a block's contacts fill the batches together; blocks are
   // the unit of work of the threads). A tuning knob only: results do not depend on it (the batches
   // pad their lanes, ContactBatch::pad_lanes). 128: docs/performance.md.
@@ -318,6 +324,13 @@ class Simulation {
   std::size_t split_rows_ = 0;                 // rows when the split was made
   int split_age_ = 0;                          // force passes since
   static constexpr int kSplitEvery = 50;
+  // Threads' shares of the work (split_work), and their time in the blocks since the split [s]
+  // (use_speed_split, balance_speeds, looked at every kSpeedEvery passes).
+  std::vector<double> thread_share_;
+  std::vector<double> thread_busy_;
+  static constexpr int kSpeedEvery = 10;
+  int speed_age_ = 0;  // force passes since the speeds were measured afresh
+  bool balance_speeds();  // true: the shares moved, split again
   bool body_terms_ready_ = false;            // ball_kin_[i].terms are up to date (see force_pass)
   // The hill parameters the batched pass reads, by set: row c's are hill_sets_[row_hill_set_[c]], the
   // distinct parameters of the rows and the rules (a few: the rules', and what make_wet and stages
