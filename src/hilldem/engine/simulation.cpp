@@ -1042,8 +1042,8 @@ bool Simulation::balance_speeds() {
   // proportion to the speeds, half way from the last shares (the speeds are noisy); a new split only
   // if a share moved by more than 1 %. Which balls a thread sums changes no result (force_pass).
   const std::size_t threads = thread_share_.size();
-  if (!use_speed_split || !thread_shares.empty() || threads < 2 || thread_busy_.size() != threads || work_start_.size() != threads + 1 ||
-      work_prefix_.size() != balls.size() + 1)
+  if (!use_speed_split || !thread_shares.empty() || threads < 2 || thread_busy_.size() != threads ||
+      work_start_.size() != threads + 1 || work_prefix_.size() != balls.size() + 1)
     return false;
   std::vector<double> speed(threads);
   double total = 0.0;
@@ -1053,11 +1053,18 @@ bool Simulation::balance_speeds() {
     speed[t] = work / thread_busy_[t];
     total += speed[t];
   }
+  // (No share below a tenth of an equal one: a thread with no balls could not be timed again.)
+  const double least = 0.1 / static_cast<double>(threads);
+  std::vector<double> share(threads);
+  double sum = 0.0;
+  for (std::size_t t = 0; t < threads; ++t) {
+    share[t] = std::max(0.5 * thread_share_[t] + 0.5 * speed[t] / total, least);
+    sum += share[t];
+  }
   bool moved = false;
   for (std::size_t t = 0; t < threads; ++t) {
-    const double share = 0.5 * thread_share_[t] + 0.5 * speed[t] / total;
-    moved |= std::abs(share - thread_share_[t]) > 0.01;
-    thread_share_[t] = share;
+    moved |= std::abs(share[t] / sum - thread_share_[t]) > 0.01;
+    thread_share_[t] = share[t] / sum;
   }
   return moved;
 }
@@ -1085,7 +1092,8 @@ void Simulation::split_work(int threads) {
   if (thread_shares.size() == count) {
     const double sum = std::accumulate(thread_shares.begin(), thread_shares.end(), 0.0);
     thread_share_.resize(count);
-    for (std::size_t t = 0; t < count; ++t) thread_share_[t] = sum > 0.0 ? std::max(thread_shares[t], 0.0) / sum : 1.0 / threads;
+    for (std::size_t t = 0; t < count; ++t)
+      thread_share_[t] = sum > 0.0 ? std::max(thread_shares[t], 0.0) / sum : 1.0 / threads;
   } else if (thread_share_.size() != count || !use_speed_split) {
     thread_share_.assign(count, 1.0 / threads);
   }
