@@ -1097,6 +1097,7 @@ void Simulation::split_work(int threads) {
   } else if (thread_share_.size() != count || !use_speed_split) {
     thread_share_.assign(count, 1.0 / threads);
   }
+  shares_by_speed_ = thread_shares.size() != count && use_speed_split;
   double before = 0.0;
   for (std::size_t t = 1; t < count; ++t) {
     before += thread_share_[t - 1];
@@ -1137,7 +1138,6 @@ void Simulation::refresh_live_rows() {
   std::vector<std::uint8_t> kind(contacts.size(), kNeither);
   live_first_.assign(n + 1, 0);
   near_first_.assign(n + 1, 0);
-  std::vector<std::uint32_t>& near_first = near_first_;
 #pragma omp parallel for schedule(static) if (n > kParallelMin)
   for (std::size_t a = 0; a < n; ++a) {
     std::uint32_t live = 0, near = 0;
@@ -1147,17 +1147,17 @@ void Simulation::refresh_live_rows() {
       near += kind[c] == kNear;
     }
     live_first_[a + 1] = live;
-    near_first[a + 1] = near;
+    near_first_[a + 1] = near;
   }
   for (std::size_t a = 0; a < n; ++a) {
     live_first_[a + 1] += live_first_[a];
-    near_first[a + 1] += near_first[a];
+    near_first_[a + 1] += near_first_[a];
   }
   live_rows_.resize(live_first_[n]);
-  near_rows_.resize(near_first[n]);
+  near_rows_.resize(near_first_[n]);
 #pragma omp parallel for schedule(static) if (n > kParallelMin)
   for (std::size_t a = 0; a < n; ++a) {
-    std::uint32_t l = live_first_[a], m = near_first[a];
+    std::uint32_t l = live_first_[a], m = near_first_[a];
     for (std::size_t c = first_rows_[a]; c < first_rows_[a + 1]; ++c) {
       if (kind[c] == kLive) live_rows_[l++] = static_cast<std::uint32_t>(c);
       if (kind[c] == kNear) near_rows_[m++] = static_cast<std::uint32_t>(c);
@@ -1225,8 +1225,10 @@ void Simulation::force_pass(double dt) {
       // the thread count changed, every kSplitEvery passes, or when the threads' speeds moved their
       // shares (balance_speeds, every kSpeedEvery passes).
       const auto threads = static_cast<std::size_t>(omp_get_num_threads());
+      // (use_speed_split turned off: equal shares from this pass on.)
       bool resplit = work_start_.size() != threads + 1 || work_start_.back() != n || split_rows_ != rows ||
-                     thread_share_.size() != threads || ++split_age_ >= kSplitEvery;
+                     thread_share_.size() != threads || (shares_by_speed_ && !use_speed_split) ||
+                     ++split_age_ >= kSplitEvery;
       if (!resplit && ++speed_age_ >= kSpeedEvery) resplit = balance_speeds();
       if (resplit) {
         split_work(omp_get_num_threads());

@@ -330,6 +330,7 @@ class Simulation {
   std::vector<double> thread_busy_;
   static constexpr int kSpeedEvery = 10;
   int speed_age_ = 0;  // force passes since the speeds were measured afresh
+  bool shares_by_speed_ = false;  // the split's shares came from the speeds
   bool balance_speeds();  // true: the shares moved, split again
   bool body_terms_ready_ = false;            // ball_kin_[i].terms are up to date (see force_pass)
   // The hill parameters the batched pass reads, by set: row c's are hill_sets_[row_hill_set_[c]], the
