@@ -85,7 +85,8 @@ std::int64_t settle_bed(const std::string& in, const std::string& out, double ra
 }
 
 const std::vector<std::string>& alternate_switches() {
-  static const std::vector<std::string> names{"vector-fill", "branchless-rows", "live-rows", "speed-split"};
+  static const std::vector<std::string> names{"vector-fill", "branchless-rows", "live-rows", "speed-split",
+                                               "record-motion"};
   return names;
 }
 
@@ -98,8 +99,9 @@ bool& switch_of(Simulation& sim, const std::string& name) {
   }
   if (name == "live-rows") return sim.use_live_rows;
   if (name == "speed-split") return sim.use_speed_split;
+  if (name == "record-motion") return sim.use_record_motion;
   throw InputError("bench --alternate: unknown switch '" + name +
-                   "' (allowed: vector-fill, branchless-rows, live-rows, speed-split)");
+                   "' (allowed: vector-fill, branchless-rows, live-rows, speed-split, record-motion)");
 }
 }  // namespace
 

@@ -26,6 +26,7 @@
 #include "hilldem/core/error.hpp"
 #include "hilldem/engine/contact_batch.hpp"
 #include "hilldem/engine/thread_budget.hpp"
+#include "hilldem/motion/ball_step.hpp"
 
 namespace hilldem {
 
@@ -49,11 +50,13 @@ bool same_bits(const HillParams& x, const HillParams& y) { return param_bits(x) 
 }  // namespace
 
 void Simulation::cycle(std::int64_t n) {
+  drop_records();  // the caller may have changed the columns since the last call
   for (std::int64_t k = 0; k < n; ++k) step_once(k + 1 == n);
 }
 
 std::int64_t Simulation::solve(double ratio, std::int64_t max_steps) {
   // At least one cycle: forces may be stale (make_wet changes them only on the next cycle, §2.7).
+  drop_records();
   for (std::int64_t k = 1; k <= max_steps; ++k) {
     step_once(true);  // the ratio reads the contact results
     if (mean_unbalanced_ratio() <= ratio) return k;
@@ -62,6 +65,7 @@ std::int64_t Simulation::solve(double ratio, std::int64_t max_steps) {
 }
 
 void Simulation::update_forces() {
+  drop_records();
   rebuild_if_needed();
   write_results_ = true;
   force_pass(0.0);
@@ -83,11 +87,23 @@ double Simulation::skin() const {
 }
 
 void Simulation::step_once(bool last) {
-  // The reported results of ball-ball contacts only when someone may read them (see cycle()).
-  write_results_ = last || !observers.empty() || !controllers.empty();
+  try {
+    step_body(last);
+  } catch (...) {
+    sync_ball_columns();  // the state where the run stopped, for whoever catches this
+    throw;
+  }
+}
+
+void Simulation::step_body(bool last) {
+  // The reported results of ball-ball contacts, and the balls' columns, only when someone may read
+  // them (see cycle()).
+  const bool watched = last || !observers.empty() || !controllers.empty();
+  write_results_ = watched;
   apply_thread_budget();  // when several simulations share the cores (engine/thread_budget.hpp)
   if (!forces_ready_) update_forces();
   const double dt = next_timestep();
+  if (!controllers.empty()) drop_records();  // they may set the columns' velocities
   for (const auto& control : controllers) control(*this, dt);  // servos set wall velocities
   const double* m_scaled = nullptr;
   const double* i_scaled = nullptr;
@@ -106,7 +122,13 @@ void Simulation::step_once(bool last) {
     m_scaled = scaled_mass_.data();
     i_scaled = scaled_inertia_.data();
   }
-  advance_balls(balls, MotionSettings{settings.gravity, settings.local_damping}, dt, m_scaled, i_scaled);  // §1.2 steps 1-2
+  // §1.2 steps 1-2
+  if (use_record_motion && records_current_ && ball_kin_.size() == balls.size()) {
+    advance_records(dt, m_scaled, i_scaled, watched);
+  } else {
+    drop_records();
+    advance_balls(balls, MotionSettings{settings.gravity, settings.local_damping}, dt, m_scaled, i_scaled);
+  }
   for (Wall& w : walls.walls) {
     // Bound on how far any point of the wall moved (for the neighbour-list check).
     double reach = 0.0;
@@ -128,11 +150,13 @@ void Simulation::step_once(bool last) {
 
 ContactGeometry Simulation::geometry(std::size_t c) const {
   const ContactKey& k = contacts.key[c];
-  const Vec3& x1 = balls.position[k.a];
+  // (Between steps the columns hold the positions; within an unwatched step the records.)
+  auto position = [&](std::size_t i) -> const Vec3& { return columns_stale_ ? ball_kin_[i].position : balls.position[i]; };
+  const Vec3& x1 = position(k.a);
   const double r1 = balls.radius[k.a];
   ContactGeometry g;
   if (k.kind == ContactKind::BallBall) {
-    Vec3 x2 = balls.position[k.b];
+    Vec3 x2 = position(k.b);
     if (contacts.image[c] != kNoImage) x2 += image_shift(contacts.image[c], settings.box);
     const Vec3 d = x2 - x1;
     const double dist = norm(d);
@@ -238,37 +262,107 @@ void Simulation::wrap_positions() {
       }
 }
 
-void Simulation::rebuild_if_needed() {
-  if (!rebuild_needed_ && position_at_build_.size() == balls.size()) {
-    const double half = 0.5 * skin();
-    // Largest squared travel since the rebuild [m²]; a NaN wins (not std::max, which would drop it).
-    // Parallel: the maximum does not depend on the order, and any NaN ends the run below.
-    const std::size_t n = balls.size();
-    double worst = 0.0;
-    // And the largest travel since the live rows were made (refresh_live_rows), while they are.
-    const bool live = live_ready_ && position_at_live_.size() == n;
-    double worst_live = 0.0;
+void Simulation::advance_records(double dt, const double* inertial_mass, const double* inertial_inertia,
+                                 bool write_columns) {
+  // One pass over the balls where there were three (the law of motion on the columns, the travel
+  // check, the force pass's copy into the records), ≈ 660 bytes streamed a ball a step against ≈ 420
+  // here: 1.04 x at 100,800 spheres (docs/performance.md, fifteenth session). The law is
+  // advance_balls's (motion::step_ball), the travel the check's expression.
+  using namespace motion;
+  const std::size_t n = balls.size();
+  const double alpha = settings.local_damping;
+  const V4 gravity = load(settings.gravity);
+  const bool travel = position_at_build_.size() == n;
+  const bool live = live_ready_ && position_at_live_.size() == n;
+  BallKin* kin = ball_kin_.data();
+  double worst = 0.0, worst_live = 0.0;  // [m²] (a NaN wins: see rebuild_if_needed)
 #pragma omp parallel if (n > kParallelMin)
-    {
-      double mine = 0.0, mine_live = 0.0;
+  {
+    double mine = 0.0, mine_live = 0.0;
 #pragma omp for schedule(static) nowait
-      for (std::size_t i = 0; i < n; ++i) {
-        const double d2 = norm2(balls.position[i] - position_at_build_[i]);
-        if (!(d2 <= mine)) mine = d2;
-        if (live) {
-          const double l2 = norm2(balls.position[i] - position_at_live_[i]);
-          if (!(l2 <= mine_live)) mine_live = l2;
-        }
+    for (std::size_t i = 0; i < n; ++i) {
+      BallKin& k = kin[i];
+      V4 x = load(k.position), v = load(k.velocity), w = load(k.spin);
+      step_ball(balls, i, gravity, alpha, dt, inertial_mass, inertial_inertia, x, v, w);
+      store(k.velocity, v);
+      store(k.spin, w);
+      store(k.position, x);
+      if (write_columns) {
+        store(balls.velocity[i], v);
+        store(balls.spin[i], w);
+        store(balls.position[i], x);
       }
-#pragma omp critical(hilldem_rebuild_check)
-      {
-        if (!(mine <= worst)) worst = mine;
-        if (!(mine_live <= worst_live)) worst_live = mine_live;
+      if (travel) {
+        const double d2 = norm2(k.position - position_at_build_[i]);
+        if (!(d2 <= mine)) mine = d2;
+      }
+      if (live) {
+        const double l2 = norm2(k.position - position_at_live_[i]);
+        if (!(l2 <= mine_live)) mine_live = l2;
       }
     }
-    live_travel_ = std::sqrt(worst_live);
-    live_travel_known_ = live;
+#pragma omp critical(hilldem_record_motion)
+    {
+      if (!(mine <= worst)) worst = mine;
+      if (!(mine_live <= worst_live)) worst_live = mine_live;
+    }
+  }
+  columns_stale_ = !write_columns;
+  motion_travel_known_ = travel;
+  motion_worst_ = worst;
+  live_travel_ = std::sqrt(worst_live);
+  live_travel_known_ = live;
+}
+
+void Simulation::sync_ball_columns() {
+  if (!columns_stale_) return;
+  const std::size_t n = balls.size();
+#pragma omp parallel for schedule(static) if (n > kParallelMin)
+  for (std::size_t i = 0; i < n; ++i) {
+    balls.position[i] = ball_kin_[i].position;
+    balls.velocity[i] = ball_kin_[i].velocity;
+    balls.spin[i] = ball_kin_[i].spin;
+  }
+  columns_stale_ = false;
+}
+
+void Simulation::rebuild_if_needed() {
+  const bool measured = motion_travel_known_;  // by advance_records, this step
+  motion_travel_known_ = false;
+  if (!rebuild_needed_ && position_at_build_.size() == balls.size()) {
+    const double half = 0.5 * skin();
+    double worst = motion_worst_;  // largest squared travel since the rebuild [m²]
+    if (!measured) {
+      // A NaN wins (not std::max, which would drop it). Parallel: the maximum does not depend on
+      // the order, and any NaN ends the run below.
+      const std::size_t n = balls.size();
+      worst = 0.0;
+      // And the largest travel since the live rows were made (refresh_live_rows), while they are.
+      const bool live = live_ready_ && position_at_live_.size() == n;
+      double worst_live = 0.0;
+#pragma omp parallel if (n > kParallelMin)
+      {
+        double mine = 0.0, mine_live = 0.0;
+#pragma omp for schedule(static) nowait
+        for (std::size_t i = 0; i < n; ++i) {
+          const double d2 = norm2(balls.position[i] - position_at_build_[i]);
+          if (!(d2 <= mine)) mine = d2;
+          if (live) {
+            const double l2 = norm2(balls.position[i] - position_at_live_[i]);
+            if (!(l2 <= mine_live)) mine_live = l2;
+          }
+        }
+#pragma omp critical(hilldem_rebuild_check)
+        {
+          if (!(mine <= worst)) worst = mine;
+          if (!(mine_live <= worst_live)) worst_live = mine_live;
+        }
+      }
+      live_travel_ = std::sqrt(worst_live);
+      live_travel_known_ = live;
+    }
     if (!std::isfinite(worst)) {
+      sync_ball_columns();
       for (std::size_t i = 0; i < balls.size(); ++i)
         if (!std::isfinite(norm2(balls.position[i])))
           throw RunError("ball " + std::to_string(balls.id[i]) + " has a non-finite position at step " +
@@ -278,6 +372,7 @@ void Simulation::rebuild_if_needed() {
     // A pair outside the list was farther than `skin` beyond proximity at the rebuild.
     if (ball_travel <= half && ball_travel + wall_travel_ <= 2.0 * half) return;
   }
+  drop_records();  // the rebuild reads the columns, and wraps the positions into a periodic box
   rebuild(settings.proximity);
 }
 
@@ -409,19 +504,20 @@ Simulation::RowShare Simulation::force_row(std::size_t c, double dt) {
   const double proximity = settings.proximity;
   const bool want_stiffness = settings.auto_timestep || settings.density_scaling;
   const PeriodicBox& box = settings.box;
-  const Vec3* pos = balls.position.data();
+  // The balls' state from their records (current in the force pass; the columns may lag behind).
+  const BallKin* rec = ball_kin_.data();
   const double* rad = balls.radius.data();
   const ContactKey key = contacts.key[c];
   const std::size_t a = key.a;
   const bool ball2 = key.kind == ContactKind::BallBall;
-  const Vec3 x1 = pos[a];
+  const Vec3 x1 = rec[a].position;
   const double r1 = rad[a];
 
   // Geometry (spec §1.1). Neighbour pairs that are not contacts are rejected before any sqrt.
   Vec3 normal;
   double gap;
   if (ball2) {
-    Vec3 x2 = pos[key.b];
+    Vec3 x2 = rec[key.b].position;
     if (contacts.image[c] != kNoImage) x2 += image_shift(contacts.image[c], box);
     const Vec3 d = x2 - x1;
     const double dist2 = norm2(d);
@@ -445,16 +541,16 @@ Simulation::RowShare Simulation::force_row(std::size_t c, double dt) {
   const Vec3 point = x1 + normal * arm1;                // x_c, centre of the gap/overlap
 
   // Relative velocity of the material points at x_c (spec §1.2) and the mean spin about n̂_c.
-  const Vec3 v1 = balls.velocity[a] + cross(balls.spin[a], normal * arm1);
+  const Vec3 v1 = rec[a].velocity + cross(rec[a].spin, normal * arm1);
   Vec3 v2, spin2;
   if (ball2) {
-    spin2 = balls.spin[key.b];
-    v2 = balls.velocity[key.b] - cross(spin2, normal * (rad[key.b] + 0.5 * gap));
+    spin2 = rec[key.b].spin;
+    v2 = rec[key.b].velocity - cross(spin2, normal * (rad[key.b] + 0.5 * gap));
   } else {
     v2 = wall_point_velocity(walls.walls[key.b], point);
     spin2 = walls.walls[key.b].spin;
   }
-  const PlaneRotation rotation(contacts.normal[c], normal, 0.5 * dot(balls.spin[a] + spin2, normal), dt);
+  const PlaneRotation rotation(contacts.normal[c], normal, 0.5 * dot(rec[a].spin + spin2, normal), dt);
   const ContactKinematics kin{normal, gap, v2 - v1, dt};
 
   RowOutcome out;
@@ -1007,7 +1103,7 @@ void Simulation::wall_block(std::size_t k0, std::size_t k1, double dt, BlockScra
     }
     const std::size_t a = contacts.key[c].a;
     const Wall& w = walls.walls[contacts.key[c].b];
-    const Vec3 x1 = balls.position[a];
+    const Vec3 x1 = ball_kin_[a].position;  // (the records: current in the force pass)
     const double r1 = balls.radius[a];
     const auto touch = wall_touch(w, x1, r1);
     if (!touch) {  // (the contact is deleted: force_row)
@@ -1021,9 +1117,9 @@ void Simulation::wall_block(std::size_t k0, std::size_t k1, double dt, BlockScra
     batch.col(F::kGap)[lane] = touch->gap;
     batch.col(F::kR1)[lane] = r1;
     batch.col(F::kR2)[lane] = -0.5 * touch->gap;  // the wall's arm R2 + g/2 is then exactly 0
-    batch.put3(F::kVax, lane, balls.velocity[a]);
+    batch.put3(F::kVax, lane, ball_kin_[a].velocity);
     batch.put3(F::kVbx, lane, wall_point_velocity(w, x1 + touch->normal * arm1));
-    batch.put3(F::kWax, lane, balls.spin[a]);
+    batch.put3(F::kWax, lane, ball_kin_[a].spin);
     batch.put3(F::kWbx, lane, w.spin);
     batch.put3(F::kNox, lane, contacts.normal[c]);
     batch.put3(F::kSx, lane, contacts.shear_state[c]);
@@ -1129,11 +1225,11 @@ void Simulation::refresh_live_rows() {
   auto kind_of = [&](std::size_t c) -> std::uint8_t {
     if (contacts.exists[c] || contacts.model[c] != ModelKind::Hill) return kLive;
     const ContactKey& k = contacts.key[c];
-    Vec3 xb = balls.position[k.b];
+    Vec3 xb = ball_kin_[k.b].position;
     if (contacts.image[c] != kNoImage) xb += image_shift(contacts.image[c], settings.box);
-    const double radii = balls.radius[k.a] + balls.radius[k.b];
+    const double radii = ball_kin_[k.a].radius + ball_kin_[k.b].radius;
     const double reach = (radii + proximity + 2.0 * slack) * (1.0 + 1e-9);
-    return norm2(xb - balls.position[k.a]) > reach * reach ? kNeither : kNear;
+    return norm2(xb - ball_kin_[k.a].position) > reach * reach ? kNeither : kNear;
   };
   std::vector<std::uint8_t> kind(contacts.size(), kNeither);
   live_first_.assign(n + 1, 0);
@@ -1163,7 +1259,8 @@ void Simulation::refresh_live_rows() {
       if (kind[c] == kNear) near_rows_[m++] = static_cast<std::uint32_t>(c);
     }
   }
-  position_at_live_ = balls.position;
+  position_at_live_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) position_at_live_[i] = ball_kin_[i].position;
   live_proximity_ = settings.proximity;
   live_rows_of_ = contacts.size();
   live_ready_ = true;
@@ -1185,7 +1282,33 @@ void Simulation::force_pass(double dt) {
   std::int64_t batched = 0;
   const bool terms_ready = body_terms_ready_ && ball_kin_.size() == n;
   if (!terms_ready || hill_sets_stale_ || row_hill_set_.size() != rows) refresh_param_sets();
+  if (ball_kin_.size() != n) drop_records();
   ball_kin_.resize(n);
+  // What the pair loop reads of each ball, in one record (two cache lines): one memory stream per
+  // neighbourhood instead of one per column. The position, velocity and spin from the columns unless
+  // the records hold them already (advance_records, or an earlier pass in this step); the hill terms
+  // (four divisions per ball) only when the properties may have changed: at a rebuild,
+  // refresh_mappings() or a restore, the moments at which the row-by-row path's mappings are computed
+  // too (real masses, §2.4). (Within a cycle() call nothing changes a radius, but a controller,
+  // and a controller drops the records.)
+  if (!records_current_ || !terms_ready) {
+    const bool copy = !records_current_;
+#pragma omp parallel for schedule(static) if (n > kParallelMin)
+    for (std::size_t i = 0; i < n; ++i) {
+      BallKin& k = ball_kin_[i];
+      if (copy) {
+        k.position = balls.position[i];
+        k.radius = balls.radius[i];
+        k.velocity = balls.velocity[i];
+        k.spin = balls.spin[i];
+      }
+      if (!terms_ready) {
+        k.radius = balls.radius[i];
+        k.terms = hill_body_terms(balls.radius[i], balls.young_mod[i], balls.pois_ratio[i], balls.mass[i]);
+      }
+    }
+    records_current_ = true;
+  }
   const std::size_t wall_rows = wall_rows_.size();
   ball_contacts_.resize(n);
   // The live rows (use_live_rows), made again when a ball may have moved more than the slack since
@@ -1200,20 +1323,6 @@ void Simulation::force_pass(double dt) {
   std::size_t full_balls = 0;  // balls that visited all their rows (force_block)
 #pragma omp parallel reduction(min : bad_row) reduction(+ : batched, full_balls) if (n > kParallelMin)
   {
-    // What the pair loop reads of each ball, in one record (two cache lines): one memory stream per
-    // neighbourhood instead of one per column. The hill terms (four divisions per ball) only when the
-    // properties may have changed: at a rebuild, refresh_mappings() or a restore, the moments at which
-    // the row-by-row path's mappings are computed too (real masses, §2.4).
-#pragma omp for schedule(static)
-    for (std::size_t i = 0; i < n; ++i) {
-      BallKin& k = ball_kin_[i];
-      k.position = balls.position[i];
-      k.radius = balls.radius[i];
-      k.velocity = balls.velocity[i];
-      k.spin = balls.spin[i];
-      if (!terms_ready)
-        k.terms = hill_body_terms(balls.radius[i], balls.young_mod[i], balls.pois_ratio[i], balls.mass[i]);
-    }
     // ≈ 60 kB: on the heap, not the thread's stack. Default-initialised: make_unique would zero it on
     // every pass (≈ 1 % of the in-cache bed's instructions, callgrind; 1.023 x there without, 6 pairs),
     // and every lane value a law or the scatter uses is written before it is read.
@@ -1311,7 +1420,7 @@ void Simulation::collect_forces() {
     if (want_stiffness) add_row_stiffness(c, balls.radius[k.a], ball_k_tran_[k.a], ball_k_rot_[k.a]);
     if (!contacts.active[c]) continue;
     Wall& w = walls.walls[k.b];
-    const Vec3 point = balls.position[k.a] + contacts.normal[c] * (balls.radius[k.a] + 0.5 * contacts.gap[c]);
+    const Vec3 point = ball_kin_[k.a].position + contacts.normal[c] * (balls.radius[k.a] + 0.5 * contacts.gap[c]);
     w.force += contacts.force[c];
     w.moment += cross(point - w.rotation_center, contacts.force[c]);
     w.normal_force += dot(contacts.force[c], contacts.normal[c]);

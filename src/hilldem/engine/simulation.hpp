@@ -135,6 +135,16 @@ class Simulation {
   bool use_live_rows = true;
   // How often the live rows were made.
   std::int64_t live_row_refreshes() const { return live_refreshes_; }
+  // Within a cycle() or solve() call, the law of motion moves the balls' records (the position,
+  // velocity and spin the force pass reads) and measures how far each ball travelled since the
+  // neighbour list and the live rows were made, in one pass; the BallStore's columns are written too
+  // only on the steps someone may look at (the last, and every step while an observer or controller
+  // is registered). false: the columns are moved (advance_balls), the travel is measured in a second
+  // pass, and the force pass copies the columns into the records, three passes over the balls. The
+  // same bits either way (one law, motion/ball_step.hpp; test
+  // Motion.RecordsOrColumnsGiveTheSameBits): 1.04 x at 100,800 spheres, 1.02-1.03 x at 11,200 and in
+  // cache (docs/performance.md, fifteenth session).
+  bool use_record_motion = true;
   // Threads share the balls of the force pass in proportion to their measured speeds (the cores of a
   // shared machine do not run equally fast); false: equal work. Results do not depend on the shares.
   bool use_speed_split = true;
@@ -187,10 +197,23 @@ class Simulation {
  private:
   // One cycle; `last`: the last of a cycle() call (its contact results are written).
   void step_once(bool last);
+  void step_body(bool last);  // step_once's work (step_once syncs the columns if it throws)
   void rebuild(double reach);
   void build_row_lists();  // per-ball row lists (CSR) and wall rows from the current rows
   void rebuild_if_needed();
   void force_pass(double dt);
+  // The law of motion on the records (use_record_motion), with each ball's travel since the
+  // neighbour list (and since the live rows) measured as it moves; write_columns: the BallStore's
+  // columns too.
+  void advance_records(double dt, const double* inertial_mass, const double* inertial_inertia, bool write_columns);
+  // The columns from the records, if the records are ahead of them (columns_stale_).
+  void sync_ball_columns();
+  // From now on the columns hold the balls' state (synced first): before anything that may read or
+  // write them (a controller, a rebuild, the start of a cycle() call).
+  void drop_records() {
+    sync_ball_columns();
+    records_current_ = false;
+  }
   // work_start_[t]: the first ball of thread t's range in the force pass, cut at equal work.
   void split_work(int threads);
   // What a row gives its two bodies (zero when the row is not an active contact).
@@ -317,6 +340,15 @@ class Simulation {
     HillBodyTerms terms;   // for the hill mappings
   };
   std::vector<BallKin> ball_kin_;             // per ball, what the batched pair loop reads
+  // The records' position, velocity and spin are the balls' state: from the force pass's copy on,
+  // and through the record motion of the steps that follow within one cycle() call. The columns
+  // lag behind while columns_stale_ (only while records_current_).
+  bool records_current_ = false;
+  bool columns_stale_ = false;
+  // advance_records measured the largest squared travel since the neighbour list [m²] (motion_worst_)
+  // for this step's rebuild_if_needed.
+  bool motion_travel_known_ = false;
+  double motion_worst_ = 0.0;
   // Per ball, its rows that were contacts in the last pass with more than one thread (split_work).
   std::vector<std::uint32_t> ball_contacts_;
   std::vector<std::size_t> work_start_;        // threads' ranges of balls in the force pass (split_work)

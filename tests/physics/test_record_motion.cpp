@@ -1,0 +1,169 @@
+// The law of motion on the force pass's ball records (Simulation::use_record_motion) against the law
+// on the BallStore's columns: the same law (motion/ball_step.hpp) and the same travel, so the same
+// bits; and the columns hold the balls' state whenever anyone outside the cycle can look: after
+// every cycle() call, in every observer and controller, after a run that threw.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "hilldem/core/error.hpp"
+#include "sim_builders.hpp"
+
+namespace hilldem {
+namespace {
+using testing::granite_row;
+using testing::random_box;
+
+// Every ball's position, velocity and spin, bit for bit.
+struct State {
+  std::vector<Vec3> position, velocity, spin;
+  std::int64_t rebuilds = 0;
+  std::size_t contacts = 0;
+};
+State state(const Simulation& sim) {
+  return {sim.balls.position, sim.balls.velocity, sim.balls.spin, sim.rebuilds(), sim.contact_count()};
+}
+bool same_bits(const Vec3& a, const Vec3& b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+void expect_same(const State& a, const State& b) {
+  EXPECT_EQ(a.rebuilds, b.rebuilds);
+  EXPECT_EQ(a.contacts, b.contacts);
+  ASSERT_EQ(a.position.size(), b.position.size());
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < a.position.size(); ++i)
+    differ += !same_bits(a.position[i], b.position[i]) || !same_bits(a.velocity[i], b.velocity[i]) ||
+              !same_bits(a.spin[i], b.spin[i]);
+  EXPECT_EQ(differ, 0u) << "balls whose state differs";
+}
+
+// A box of 600 grains thrown about under gravity, with local damping, walls (linear rows through
+// wall_block and force_row), a few balls fixed in some directions, wet half way.
+Simulation busy_box() {
+  Simulation sim = random_box(600, 33);
+  sim.settings.gravity = {0, 0, -9.81};
+  sim.settings.local_damping = 0.3;
+  for (std::size_t i = 0; i < sim.balls.size(); i += 37) sim.balls.fixity[i] = static_cast<FixityMask>(i % 64);
+  return sim;
+}
+
+// Long cycle() calls (the records carry the state from step to step), dry then wet, in a walled box
+// and in a periodic one (rebuilds wrap the positions), and with density scaling.
+TEST(Motion, RecordsOrColumnsGiveTheSameBits) {
+  auto walled = [](bool records) {
+    Simulation sim = busy_box();
+    sim.use_record_motion = records;
+    sim.cycle(400);
+    sim.make_wet(20e3, 0.5e-3);
+    sim.cycle(400);
+    return state(sim);
+  };
+  const State a = walled(true), b = walled(false);
+  EXPECT_GT(a.rebuilds, 2);
+  EXPECT_GT(a.contacts, 100u);
+  expect_same(a, b);
+
+  auto periodic = [](bool records) {
+    Simulation sim = random_box(400, 8, /*walls=*/false);
+    sim.settings.box.periodic[0] = sim.settings.box.periodic[1] = sim.settings.box.periodic[2] = true;
+    sim.settings.box.hi = {0.04, 0.04, 0.04};
+    for (std::size_t i = 0; i < sim.balls.size(); ++i) {
+      sim.balls.velocity[i] *= 10.0;                    // [m/s]
+      sim.balls.position[i] += Vec3{0.02, 0.013, 0.0};  // [m] the boundaries cut the cloud
+    }
+    sim.use_record_motion = records;
+    sim.cycle(600);
+    return state(sim);
+  };
+  const State p = periodic(true), q = periodic(false);
+  EXPECT_GT(p.rebuilds, 2);
+  expect_same(p, q);
+
+  auto scaled = [](bool records) {
+    Simulation sim = busy_box();
+    sim.settings.auto_timestep = false;
+    sim.settings.timestep = 4e-6;  // [s]
+    sim.settings.density_scaling = true;
+    sim.use_record_motion = records;
+    sim.cycle(500);
+    return state(sim);
+  };
+  expect_same(scaled(true), scaled(false));
+}
+
+// What the caller writes into the columns between cycle() calls counts, and so does what a
+// controller writes there before the motion of its step; observers see the step's state.
+TEST(Motion, ColumnsAreTheStateWheneverSomeoneLooks) {
+  auto run = [](bool records, std::vector<Vec3>* seen) {
+    Simulation sim = busy_box();
+    sim.use_record_motion = records;
+    sim.cycle(150);
+    sim.balls.velocity[5] = {0.3, -0.2, 0.1};  // [m/s] by hand, between two calls
+    sim.balls.position[6] += Vec3{0.0, 0.0, 1e-4};  // [m]
+    sim.invalidate_neighbours();
+    sim.cycle(150);
+    // (Held at 0.1 m/s upwards against gravity: the step's motion must start from it.)
+    sim.controllers.push_back([](Simulation& s, double) { s.balls.velocity[7] = {0.0, 0.0, 0.1}; });  // [m/s]
+    sim.observers.push_back([seen](const Simulation& s) { seen->push_back(s.balls.position[8]); });
+    sim.cycle(100);
+    sim.controllers.clear();
+    sim.cycle(100);  // (the observer still looks)
+    return state(sim);
+  };
+  std::vector<Vec3> seen_records, seen_columns;
+  const State a = run(true, &seen_records), b = run(false, &seen_columns);
+  expect_same(a, b);
+  ASSERT_EQ(seen_records.size(), 200u);
+  ASSERT_EQ(seen_columns.size(), 200u);
+  for (std::size_t k = 0; k < seen_records.size(); ++k) EXPECT_TRUE(same_bits(seen_records[k], seen_columns[k])) << k;
+  // Each step's own position, not the last one's (the ball moves).
+  EXPECT_FALSE(same_bits(seen_records.front(), seen_records.back()));
+}
+
+// Steps nobody watches leave the columns behind the records; a run that fails in one of them still
+// leaves its state in the columns (the state where it stopped, as the column motion does).
+TEST(Motion, ColumnsHoldTheStateAfterARunFails) {
+  auto run = [](bool records) {
+    Simulation sim = busy_box();
+    sim.use_record_motion = records;
+    sim.settings.auto_timestep = false;
+    sim.settings.timestep = 2e-4;  // [s] far beyond the critical step: the run blows up
+    std::string message;
+    try {
+      sim.cycle(100000);
+    } catch (const RunError& e) {
+      message = e.what();
+    }
+    return std::make_pair(message, state(sim));
+  };
+  const auto [message_records, records] = run(true);
+  const auto [message_columns, columns] = run(false);
+  EXPECT_NE(message_records.find("non-finite position"), std::string::npos) << message_records;
+  EXPECT_EQ(message_records, message_columns);
+  expect_same(records, columns);
+
+  // A non-finite force (the force pass throws, not the travel check): a ball with a NaN applied
+  // moment spins NaN from the first step, and its contact, made some steps later, has no finite force.
+  auto spin = [](bool records) {
+    Simulation sim = granite_row({0.1e-3});  // [m]
+    sim.balls.velocity[0] = {1.0, 0.0, 0.0};  // [m/s] towards ball 2: they touch after ≈ 100 steps
+    sim.balls.applied_moment[0] = {0.0, 0.0, std::nan("")};
+    sim.use_record_motion = records;
+    std::string message;
+    try {
+      sim.cycle(1000);
+    } catch (const RunError& e) {
+      message = e.what();
+    }
+    return std::make_pair(message, state(sim));
+  };
+  const auto [spin_message_records, spin_records] = spin(true);
+  const auto [spin_message_columns, spin_columns] = spin(false);
+  EXPECT_NE(spin_message_records.find("non-finite contact force"), std::string::npos) << spin_message_records;
+  EXPECT_EQ(spin_message_records, spin_message_columns);
+  expect_same(spin_records, spin_columns);
+}
+
+}  // namespace
+}  // namespace hilldem
