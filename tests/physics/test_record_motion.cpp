@@ -90,6 +90,19 @@ TEST(Motion, RecordsOrColumnsGiveTheSameBits) {
     return state(sim);
   };
   expect_same(scaled(true), scaled(false));
+
+  // Applied loads on a few balls (the motion then reads them: motion::step_ball<true>).
+  auto loaded = [](bool records) {
+    Simulation sim = busy_box();
+    for (std::size_t i = 3; i < sim.balls.size(); i += 50) {
+      sim.balls.applied_force[i] = {0.0, 0.0, 0.02};  // [N]
+      sim.balls.applied_moment[i] = {1e-5, 0.0, 0.0};  // [N m]
+    }
+    sim.use_record_motion = records;
+    sim.cycle(300);
+    return state(sim);
+  };
+  expect_same(loaded(true), loaded(false));
 }
 
 // What the caller writes into the columns between cycle() calls counts, and so does what a
@@ -101,6 +114,10 @@ TEST(Motion, ColumnsAreTheStateWheneverSomeoneLooks) {
     sim.cycle(150);
     sim.balls.velocity[5] = {0.3, -0.2, 0.1};  // [m/s] by hand, between two calls
     sim.balls.position[6] += Vec3{0.0, 0.0, 1e-4};  // [m]
+    sim.invalidate_neighbours();
+    sim.cycle(150);
+    for (double& r : sim.balls.radius) r *= 0.7;  // [m] a new mean radius: a new skin (and new rebuilds)
+    sim.refresh_mappings();
     sim.invalidate_neighbours();
     sim.cycle(150);
     // (Held at 0.1 m/s upwards against gravity: the step's motion must start from it.)

@@ -213,6 +213,8 @@ class Simulation {
   void drop_records() {
     sync_ball_columns();
     records_current_ = false;
+    applied_known_ = false;
+    skin_known_ = false;
   }
   // work_start_[t]: the first ball of thread t's range in the force pass, cut at equal work.
   void split_work(int threads);
@@ -338,6 +340,8 @@ class Simulation {
     Vec3 velocity;         // [m/s]
     Vec3 spin;             // [rad/s]
     HillBodyTerms terms;   // for the hill mappings
+    double mass = 0.0;     // [kg] and [kg m²]: for the record motion (in the record's last 16 bytes,
+    double inertia = 0.0;  // which the pair loop does not read)
   };
   std::vector<BallKin> ball_kin_;             // per ball, what the batched pair loop reads
   // The records' position, velocity and spin are the balls' state: from the force pass's copy on,
@@ -349,6 +353,12 @@ class Simulation {
   // for this step's rebuild_if_needed.
   bool motion_travel_known_ = false;
   double motion_worst_ = 0.0;
+  // Within one cycle() call nothing but a controller changes the applied loads or the radii, and a
+  // controller drops the records: what the record motion knows of them holds until drop_records().
+  // applied_zero_: every applied force and moment is +0.0 (motion::step_ball<false>).
+  bool applied_known_ = false, applied_zero_ = false;
+  bool skin_known_ = false;
+  double skin_ = 0.0;  // [m] skin() while skin_known_
   // Per ball, its rows that were contacts in the last pass with more than one thread (split_work).
   std::vector<std::uint32_t> ball_contacts_;
   std::vector<std::size_t> work_start_;        // threads' ranges of balls in the force pass (split_work)

@@ -48,15 +48,22 @@ HILLDEM_INLINE M4 fixed_lanes(FixityMask fix, int d0) {
 
 // Ball i's velocity v and spin w from t−Δt/2 to t+Δt/2 with its forces at t (the BallStore's sums,
 // m g, the applied loads), then its position x to t+Δt. x, v and w come in and go out through the
-// caller (a column or a record); inertial_mass/inertial_inertia: density scaling's, or null.
-HILLDEM_INLINE void step_ball(const BallStore& balls, std::size_t i, V4 gravity, double alpha, double dt,
-                              const double* inertial_mass, const double* inertial_inertia, V4& x, V4& v, V4& w) {
+// caller (a column or a record), and so do the mass m [kg] and inertia I [kg m²] (m g uses m);
+// inertial_mass/inertial_inertia: density scaling's, or null. kApplied = false: every applied force
+// and moment is known to be +0.0 (bit for bit), and +0.0 is added in their place, the same sums
+// without their two loads.
+template <bool kApplied = true>
+HILLDEM_INLINE void step_ball(const BallStore& balls, std::size_t i, V4 gravity, double alpha, double dt, double mass,
+                              double inertia, const double* inertial_mass, const double* inertial_inertia, V4& x,
+                              V4& v, V4& w) {
   const FixityMask fix = balls.fixity[i];
   // unbalanced_force(), unbalanced_moment()
-  const V4 f = load(balls.contact_force[i]) + gravity * balls.mass[i] + load(balls.applied_force[i]);
-  const V4 mo = load(balls.contact_moment[i]) + load(balls.applied_moment[i]);
-  const double inv_m = 1.0 / (inertial_mass ? inertial_mass[i] : balls.mass[i]);
-  const double inv_i = 1.0 / (inertial_inertia ? inertial_inertia[i] : balls.inertia[i]);
+  const V4 applied_f = kApplied ? load(balls.applied_force[i]) : V4{};
+  const V4 applied_m = kApplied ? load(balls.applied_moment[i]) : V4{};
+  const V4 f = load(balls.contact_force[i]) + gravity * mass + applied_f;
+  const V4 mo = load(balls.contact_moment[i]) + applied_m;
+  const double inv_m = 1.0 / (inertial_mass ? inertial_mass[i] : mass);
+  const double inv_i = 1.0 / (inertial_inertia ? inertial_inertia[i] : inertia);
   // ΔV = (F + F_d)/m Δt, then x += V Δt (velocities at half steps)
   v = unless_fixed(fixed_lanes(fix, 0), v, damped(f, v, alpha) * inv_m * dt);
   w = unless_fixed(fixed_lanes(fix, 3), w, damped(mo, w, alpha) * inv_i * dt);

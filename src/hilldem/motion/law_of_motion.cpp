@@ -13,7 +13,7 @@ void advance_balls(BallStore& balls, const MotionSettings& s, double dt, const d
 #pragma omp parallel for schedule(static) if (n > kParallelMin)
   for (std::size_t i = 0; i < n; ++i) {
     V4 x = load(balls.position[i]), v = load(balls.velocity[i]), w = load(balls.spin[i]);
-    step_ball(balls, i, gravity, alpha, dt, inertial_mass, inertial_inertia, x, v, w);
+    step_ball(balls, i, gravity, alpha, dt, balls.mass[i], balls.inertia[i], inertial_mass, inertial_inertia, x, v, w);
     store(balls.velocity[i], v);
     store(balls.spin[i], w);
     store(balls.position[i], x);
