@@ -286,12 +286,25 @@ void Simulation::advance_records(double dt, const double* inertial_mass, const d
   }
   BallKin* kin = ball_kin_.data();
   double worst = 0.0, worst_live = 0.0;  // [m²] (a NaN wins: see rebuild_if_needed)
+  // Each thread's balls: in proportion to the threads' shares of the force pass (thread_share_:
+  // equal, given or by their measured speeds), so that a thread on a slower core is not the one
+  // every other waits for. Which thread moves a ball changes no result.
+  const std::vector<double> shares = thread_share_;
   auto pass = [&](auto applied) {
 #pragma omp parallel if (n > kParallelMin)
     {
       double mine = 0.0, mine_live = 0.0;
-#pragma omp for schedule(static) nowait
-      for (std::size_t i = 0; i < n; ++i) {
+      const auto threads = static_cast<std::size_t>(omp_get_num_threads());
+      const auto t = static_cast<std::size_t>(omp_get_thread_num());
+      std::size_t i0 = n * t / threads, i1 = n * (t + 1) / threads;
+      if (shares.size() == threads) {
+        double before = 0.0;
+        for (std::size_t s = 0; s < t; ++s) before += shares[s];
+        const auto at = [n](double f) { return static_cast<std::size_t>(static_cast<double>(n) * std::clamp(f, 0.0, 1.0)); };
+        i0 = t == 0 ? 0 : at(before);
+        i1 = t + 1 == threads ? n : at(before + shares[t]);
+      }
+      for (std::size_t i = i0; i < i1; ++i) {
         BallKin& k = kin[i];
         V4 x = load(k.position), v = load(k.velocity), w = load(k.spin);
         step_ball<decltype(applied)::value>(balls, i, gravity, alpha, dt, k.mass, k.inertia, inertial_mass,
