@@ -269,12 +269,13 @@ void Simulation::advance_records(double dt, const double* inertial_mass, const d
   // One pass over the balls where there were three (the law of motion on the columns, the travel
   // check, the force pass's copy into the records), ≈ 660 bytes streamed a ball a step against ≈ 420
   // here: 1.04 x at 100,800 spheres (docs/performance.md, fifteenth session). The law is
-  // advance_balls's (motion::step_ball), the travel the check's expression.
+  // advance_balls's (motion::step_ball). The travel since the live rows is measured ball by ball (the
+  // check's expression); that since the neighbour list only bounded (travel_bound_, no reference
+  // position read), exactly by rebuild_if_needed when the bound reaches half the skin.
   using namespace motion;
   const std::size_t n = balls.size();
   const double alpha = settings.local_damping;
   const V4 gravity = load(settings.gravity);
-  const bool travel = position_at_build_.size() == n;
   const bool live = live_ready_ && position_at_live_.size() == n;
   if (!applied_known_) {  // (once per cycle() call: nothing changes them until then)
     const auto zero = [](const std::vector<Vec3>& v) {
@@ -285,7 +286,8 @@ void Simulation::advance_records(double dt, const double* inertial_mass, const d
     applied_known_ = true;
   }
   BallKin* kin = ball_kin_.data();
-  double worst = 0.0, worst_live = 0.0;  // [m²] (a NaN wins: see rebuild_if_needed)
+  // [m²/s²], [m²], [m²] (a NaN wins: see rebuild_if_needed)
+  double max_v2 = 0.0, max_x2 = 0.0, worst_live = 0.0;
   // Each thread's balls: in proportion to the threads' shares of the force pass (thread_share_:
   // equal, given or by their measured speeds), so that a thread on a slower core is not the one
   // every other waits for. Which thread moves a ball changes no result.
@@ -293,7 +295,7 @@ void Simulation::advance_records(double dt, const double* inertial_mass, const d
   auto pass = [&](auto applied) {
 #pragma omp parallel if (n > kParallelMin)
     {
-      double mine = 0.0, mine_live = 0.0;
+      double mine_v2 = 0.0, mine_x2 = 0.0, mine_live = 0.0;
       const auto threads = static_cast<std::size_t>(omp_get_num_threads());
       const auto t = static_cast<std::size_t>(omp_get_thread_num());
       std::size_t i0 = n * t / threads, i1 = n * (t + 1) / threads;
@@ -317,10 +319,10 @@ void Simulation::advance_records(double dt, const double* inertial_mass, const d
           store(balls.spin[i], w);
           store(balls.position[i], x);
         }
-        if (travel) {
-          const double d2 = norm2(k.position - position_at_build_[i]);
-          if (!(d2 <= mine)) mine = d2;
-        }
+        const double v2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        const double x2 = x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
+        if (!(v2 <= mine_v2)) mine_v2 = v2;
+        if (!(x2 <= mine_x2)) mine_x2 = x2;
         if (live) {
           const double l2 = norm2(k.position - position_at_live_[i]);
           if (!(l2 <= mine_live)) mine_live = l2;
@@ -328,18 +330,20 @@ void Simulation::advance_records(double dt, const double* inertial_mass, const d
       }
 #pragma omp critical(hilldem_record_motion)
       {
-        if (!(mine <= worst)) worst = mine;
+        if (!(mine_v2 <= max_v2)) max_v2 = mine_v2;
+        if (!(mine_x2 <= max_x2)) max_x2 = mine_x2;
         if (!(mine_live <= worst_live)) worst_live = mine_live;
       }
     }
   };
-  // Without the applied loads' 48 bytes a ball when all are zero (the pass streams ≈ 420 bytes a
-  // ball; 1.0x x at 100,800 spheres, fifteenth session).
+  // Without the applied loads' 48 bytes a ball when all are zero.
   if (applied_zero_) pass(std::false_type{});
   else pass(std::true_type{});
   columns_stale_ = !write_columns;
-  motion_travel_known_ = travel;
-  motion_worst_ = worst;
+  // No ball moved farther than |V|max Δt this step, but for the rounding of x + V Δt (below
+  // 2.3e-16 |x| a step) and of |V|: a margin of 1e-9 of the first and 1e-15 |x|max [m]. A NaN stays.
+  travel_bound_ += std::sqrt(max_v2) * dt * (1.0 + 1e-9) + 1e-15 * std::sqrt(max_x2);
+  motion_travel_known_ = true;
   live_travel_ = std::sqrt(worst_live);
   live_travel_known_ = live;
 }
@@ -365,13 +369,18 @@ void Simulation::rebuild_if_needed() {
       skin_known_ = true;
     }
     const double half = 0.5 * skin();
-    double worst = motion_worst_;  // largest squared travel since the rebuild [m²]
-    if (!measured) {
+    // A pair outside the list was farther than `skin` beyond proximity at the rebuild. The record
+    // motion's bound first: the exact travel is at most the bound, so a bound within the limit gives
+    // the exact check's answer without a pass over the positions (a NaN bound fails, and goes on).
+    if (measured && travel_bound_ <= half && travel_bound_ + wall_travel_ <= 2.0 * half) return;
+    double worst = 0.0;  // largest squared travel since the rebuild [m²]
+    {
       // A NaN wins (not std::max, which would drop it). Parallel: the maximum does not depend on
       // the order, and any NaN ends the run below.
       const std::size_t n = balls.size();
-      worst = 0.0;
       // And the largest travel since the live rows were made (refresh_live_rows), while they are.
+      // (The positions from the records when the columns lag behind them.)
+      const bool from_records = columns_stale_;
       const bool live = live_ready_ && position_at_live_.size() == n;
       double worst_live = 0.0;
 #pragma omp parallel if (n > kParallelMin)
@@ -379,10 +388,11 @@ void Simulation::rebuild_if_needed() {
         double mine = 0.0, mine_live = 0.0;
 #pragma omp for schedule(static) nowait
         for (std::size_t i = 0; i < n; ++i) {
-          const double d2 = norm2(balls.position[i] - position_at_build_[i]);
+          const Vec3& x = from_records ? ball_kin_[i].position : balls.position[i];
+          const double d2 = norm2(x - position_at_build_[i]);
           if (!(d2 <= mine)) mine = d2;
           if (live) {
-            const double l2 = norm2(balls.position[i] - position_at_live_[i]);
+            const double l2 = norm2(x - position_at_live_[i]);
             if (!(l2 <= mine_live)) mine_live = l2;
           }
         }
@@ -403,7 +413,7 @@ void Simulation::rebuild_if_needed() {
                          std::to_string(steps) + ": the run is unstable; reduce the time step");
     }
     const double ball_travel = std::sqrt(worst);
-    // A pair outside the list was farther than `skin` beyond proximity at the rebuild.
+    travel_bound_ = ball_travel;  // (exact now: the record motion grows it from here)
     if (ball_travel <= half && ball_travel + wall_travel_ <= 2.0 * half) return;
   }
   drop_records();  // the rebuild reads the columns, and wraps the positions into a periodic box
@@ -464,6 +474,7 @@ void Simulation::rebuild(double proximity) {
   contacts = std::move(next);
   build_row_lists();
   position_at_build_ = balls.position;
+  travel_bound_ = 0.0;
   wall_travel_ = 0.0;
   rebuild_needed_ = false;
   body_terms_ready_ = false;

@@ -349,10 +349,13 @@ class Simulation {
   // lag behind while columns_stale_ (only while records_current_).
   bool records_current_ = false;
   bool columns_stale_ = false;
-  // advance_records measured the largest squared travel since the neighbour list [m²] (motion_worst_)
-  // for this step's rebuild_if_needed.
+  // A bound on the largest travel of a ball since the neighbour list was made [m]: exact after
+  // rebuild_if_needed's pass over the positions (0 at a rebuild), then grown by each record motion
+  // by the step's largest |V| Δt (motion_travel_known_: for this step's rebuild_if_needed). The
+  // record motion so reads no reference position; the exact pass runs only when the bound reaches
+  // half the skin, and a bound within it gives the exact check's answer: the same rebuilds.
   bool motion_travel_known_ = false;
-  double motion_worst_ = 0.0;
+  double travel_bound_ = 0.0;
   // Within one cycle() call nothing but a controller changes the applied loads or the radii, and a
   // controller drops the records: what the record motion knows of them holds until drop_records().
   // applied_zero_: every applied force and moment is +0.0 (motion::step_ball<false>).
