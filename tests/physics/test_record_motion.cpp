@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "hilldem/core/error.hpp"
@@ -138,45 +139,39 @@ TEST(Motion, ColumnsAreTheStateWheneverSomeoneLooks) {
   EXPECT_FALSE(same_bits(seen_records.front(), seen_records.back()));
 }
 
+// `steps` cycles of `sim` with the record motion on or off, to the RunError it must end in: the
+// error's message and the balls' state.
+std::pair<std::string, State> failing_run(Simulation sim, bool records, std::int64_t steps) {
+  sim.use_record_motion = records;
+  std::string message;
+  try {
+    sim.cycle(steps);
+  } catch (const RunError& e) {
+    message = e.what();
+  }
+  return {message, state(sim)};
+}
+
 // Steps nobody watches leave the columns behind the records; a run that fails in one of them still
-// leaves its state in the columns (the state where it stopped, as the column motion does).
+// leaves its state in the columns (the state where it stopped, as the column motion does), whether
+// the travel check throws or the force pass does.
 TEST(Motion, ColumnsHoldTheStateAfterARunFails) {
-  auto run = [](bool records) {
-    Simulation sim = busy_box();
-    sim.use_record_motion = records;
-    sim.settings.auto_timestep = false;
-    sim.settings.timestep = 2e-4;  // [s] far beyond the critical step: the run blows up
-    std::string message;
-    try {
-      sim.cycle(100000);
-    } catch (const RunError& e) {
-      message = e.what();
-    }
-    return std::make_pair(message, state(sim));
-  };
-  const auto [message_records, records] = run(true);
-  const auto [message_columns, columns] = run(false);
+  Simulation blows_up = busy_box();
+  blows_up.settings.auto_timestep = false;
+  blows_up.settings.timestep = 2e-4;  // [s] far beyond the critical step
+  const auto [message_records, records] = failing_run(blows_up, true, 100000);
+  const auto [message_columns, columns] = failing_run(blows_up, false, 100000);
   EXPECT_NE(message_records.find("non-finite position"), std::string::npos) << message_records;
   EXPECT_EQ(message_records, message_columns);
   expect_same(records, columns);
 
-  // A non-finite force (the force pass throws, not the travel check): a ball with a NaN applied
-  // moment spins NaN from the first step, and its contact, made some steps later, has no finite force.
-  auto spin = [](bool records) {
-    Simulation sim = granite_row({0.1e-3});  // [m]
-    sim.balls.velocity[0] = {1.0, 0.0, 0.0};  // [m/s] towards ball 2: they touch after ≈ 100 steps
-    sim.balls.applied_moment[0] = {0.0, 0.0, std::nan("")};
-    sim.use_record_motion = records;
-    std::string message;
-    try {
-      sim.cycle(1000);
-    } catch (const RunError& e) {
-      message = e.what();
-    }
-    return std::make_pair(message, state(sim));
-  };
-  const auto [spin_message_records, spin_records] = spin(true);
-  const auto [spin_message_columns, spin_columns] = spin(false);
+  // A ball with a NaN applied moment spins NaN from the first step, and its contact, made some steps
+  // later, has no finite force.
+  Simulation spins = granite_row({0.1e-3});  // [m]
+  spins.balls.velocity[0] = {1.0, 0.0, 0.0};  // [m/s] towards ball 2: they touch after ≈ 100 steps
+  spins.balls.applied_moment[0] = {0.0, 0.0, std::nan("")};
+  const auto [spin_message_records, spin_records] = failing_run(spins, true, 1000);
+  const auto [spin_message_columns, spin_columns] = failing_run(spins, false, 1000);
   EXPECT_NE(spin_message_records.find("non-finite contact force"), std::string::npos) << spin_message_records;
   EXPECT_EQ(spin_message_records, spin_message_columns);
   expect_same(spin_records, spin_columns);
