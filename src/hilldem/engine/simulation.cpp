@@ -350,7 +350,7 @@ void Simulation::advance_records(double dt, const double* inertial_mass, const d
 
 void Simulation::sync_ball_columns() {
   if (!columns_stale_) return;
-  const std::size_t n = balls.size();
+  const std::size_t n = std::min(balls.size(), ball_kin_.size());  // (the same, while the columns lag)
 #pragma omp parallel for schedule(static) if (n > kParallelMin)
   for (std::size_t i = 0; i < n; ++i) {
     balls.position[i] = ball_kin_[i].position;
