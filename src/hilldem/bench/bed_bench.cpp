@@ -100,8 +100,9 @@ bool& switch_of(Simulation& sim, const std::string& name) {
   if (name == "live-rows") return sim.use_live_rows;
   if (name == "speed-split") return sim.use_speed_split;
   if (name == "record-motion") return sim.use_record_motion;
-  throw InputError("bench --alternate: unknown switch '" + name +
-                   "' (allowed: vector-fill, branchless-rows, live-rows, speed-split, record-motion)");
+  std::string allowed;
+  for (const std::string& s : alternate_switches()) allowed += (allowed.empty() ? "" : ", ") + s;
+  throw InputError("bench --alternate: unknown switch '" + name + "' (allowed: " + allowed + ")");
 }
 }  // namespace
 

@@ -291,7 +291,7 @@ void Simulation::advance_records(double dt, const double* inertial_mass, const d
   // Each thread's balls: in proportion to the threads' shares of the force pass (thread_share_:
   // equal, given or by their measured speeds), so that a thread on a slower core is not the one
   // every other waits for. Which thread moves a ball changes no result.
-  const std::vector<double> shares = thread_share_;
+  const std::vector<double>& shares = thread_share_;  // (not changed during the pass)
   auto pass = [&](auto applied) {
 #pragma omp parallel if (n > kParallelMin)
     {
@@ -373,38 +373,35 @@ void Simulation::rebuild_if_needed() {
     // motion's bound first: the exact travel is at most the bound, so a bound within the limit gives
     // the exact check's answer without a pass over the positions (a NaN bound fails, and goes on).
     if (measured && travel_bound_ <= half && travel_bound_ + wall_travel_ <= 2.0 * half) return;
-    double worst = 0.0;  // largest squared travel since the rebuild [m²]
-    {
-      // A NaN wins (not std::max, which would drop it). Parallel: the maximum does not depend on
-      // the order, and any NaN ends the run below.
-      const std::size_t n = balls.size();
-      // And the largest travel since the live rows were made (refresh_live_rows), while they are.
-      // (The positions from the records when the columns lag behind them.)
-      const bool from_records = columns_stale_;
-      const bool live = live_ready_ && position_at_live_.size() == n;
-      double worst_live = 0.0;
+    // The largest squared travel since the rebuild [m²], exactly; a NaN wins (not std::max, which
+    // would drop it). Parallel: the maximum does not depend on the order, and any NaN ends the run
+    // below. And the largest since the live rows were made (refresh_live_rows), while they are. (The
+    // positions from the records when the columns lag behind them.)
+    const std::size_t n = balls.size();
+    const bool from_records = columns_stale_;
+    const bool live = live_ready_ && position_at_live_.size() == n;
+    double worst = 0.0, worst_live = 0.0;
 #pragma omp parallel if (n > kParallelMin)
-      {
-        double mine = 0.0, mine_live = 0.0;
+    {
+      double mine = 0.0, mine_live = 0.0;
 #pragma omp for schedule(static) nowait
-        for (std::size_t i = 0; i < n; ++i) {
-          const Vec3& x = from_records ? ball_kin_[i].position : balls.position[i];
-          const double d2 = norm2(x - position_at_build_[i]);
-          if (!(d2 <= mine)) mine = d2;
-          if (live) {
-            const double l2 = norm2(x - position_at_live_[i]);
-            if (!(l2 <= mine_live)) mine_live = l2;
-          }
-        }
-#pragma omp critical(hilldem_rebuild_check)
-        {
-          if (!(mine <= worst)) worst = mine;
-          if (!(mine_live <= worst_live)) worst_live = mine_live;
+      for (std::size_t i = 0; i < n; ++i) {
+        const Vec3& x = from_records ? ball_kin_[i].position : balls.position[i];
+        const double d2 = norm2(x - position_at_build_[i]);
+        if (!(d2 <= mine)) mine = d2;
+        if (live) {
+          const double l2 = norm2(x - position_at_live_[i]);
+          if (!(l2 <= mine_live)) mine_live = l2;
         }
       }
-      live_travel_ = std::sqrt(worst_live);
-      live_travel_known_ = live;
+#pragma omp critical(hilldem_rebuild_check)
+      {
+        if (!(mine <= worst)) worst = mine;
+        if (!(mine_live <= worst_live)) worst_live = mine_live;
+      }
     }
+    live_travel_ = std::sqrt(worst_live);
+    live_travel_known_ = live;
     if (!std::isfinite(worst)) {
       sync_ball_columns();
       for (std::size_t i = 0; i < balls.size(); ++i)
@@ -1343,16 +1340,14 @@ void Simulation::force_pass(double dt) {
       BallKin& k = ball_kin_[i];
       if (copy) {
         k.position = balls.position[i];
-        k.radius = balls.radius[i];
         k.velocity = balls.velocity[i];
         k.spin = balls.spin[i];
         k.mass = balls.mass[i];
         k.inertia = balls.inertia[i];
       }
-      if (!terms_ready) {
-        k.radius = balls.radius[i];
+      k.radius = balls.radius[i];
+      if (!terms_ready)
         k.terms = hill_body_terms(balls.radius[i], balls.young_mod[i], balls.pois_ratio[i], balls.mass[i]);
-      }
     }
     records_current_ = true;
   }
