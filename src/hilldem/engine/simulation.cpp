@@ -129,7 +129,8 @@ void Simulation::step_body(bool last) {
     advance_records(dt, m_scaled, i_scaled, watched);
   } else {
     drop_records();
-    advance_balls(balls, MotionSettings{settings.gravity, settings.local_damping}, dt, m_scaled, i_scaled);
+    advance_balls(balls, MotionSettings{settings.gravity, settings.local_damping}, dt, m_scaled, i_scaled,
+                  contact_sums());
   }
   for (Wall& w : walls.walls) {
     // Bound on how far any point of the wall moved (for the neighbour-list check).
@@ -286,6 +287,7 @@ void Simulation::advance_records(double dt, const double* inertial_mass, const d
     applied_known_ = true;
   }
   BallKin* kin = ball_kin_.data();
+  const motion::ContactSums* sums = contact_sums();
   // [m²/s²], [m²], [m²] (a NaN wins: see rebuild_if_needed)
   double max_v2 = 0.0, max_x2 = 0.0, worst_live = 0.0;
   // Each thread's balls: in proportion to the threads' shares of the force pass (thread_share_:
@@ -309,8 +311,10 @@ void Simulation::advance_records(double dt, const double* inertial_mass, const d
       for (std::size_t i = i0; i < i1; ++i) {
         BallKin& k = kin[i];
         V4 x = load(k.position), v = load(k.velocity), w = load(k.spin);
+        const V4 cf = sums ? sums[i].force : load(balls.contact_force[i]);
+        const V4 cm = sums ? sums[i].moment : load(balls.contact_moment[i]);
         step_ball<decltype(applied)::value>(balls, i, gravity, alpha, dt, k.mass, k.inertia, inertial_mass,
-                                            inertial_inertia, x, v, w);
+                                            inertial_inertia, cf, cm, x, v, w);
         store(k.velocity, v);
         store(k.spin, w);
         store(k.position, x);
@@ -349,6 +353,7 @@ void Simulation::advance_records(double dt, const double* inertial_mass, const d
 }
 
 void Simulation::sync_ball_columns() {
+  sync_sum_columns();
   if (!columns_stale_) return;
   const std::size_t n = std::min(balls.size(), ball_kin_.size());  // (the same, while the columns lag)
 #pragma omp parallel for schedule(static) if (n > kParallelMin)
@@ -532,6 +537,8 @@ void Simulation::restore_cycle_state(CycleState s) {
   for (std::size_t c = 1; c < contacts.size(); ++c)
     if (!(contacts.key[c - 1] < contacts.key[c])) throw RunError("cycle state: contact rows are not sorted by key");
   forces_ready_ = s.forces_ready;
+  sums_current_ = false;  // the restored columns hold the sums the next step moves with
+  sum_columns_stale_ = false;
   rebuild_needed_ = s.rebuild_needed || s.position_at_build.empty();
   rebuilds_ = s.rebuilds;
   unassigned_pairs_ = static_cast<std::size_t>(s.unassigned_pairs);
@@ -894,8 +901,12 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
   const PeriodicBox& box = settings.box;
   const BallKin* kin = ball_kin_.data();
   const ContactKey* keys = contacts.key.data();
-  Vec3* __restrict ball_force = balls.contact_force.data();
-  Vec3* __restrict ball_moment = balls.contact_moment.data();
+  // Each ball's force and moment sums in one line, each a vector with a +0.0 fourth lane
+  // (motion::ContactSums): a row's share into a ball is one vector operation per sum where it was
+  // three scalar ones. The same additions component by component, so the same bits (1.04 x against
+  // two Vec3 columns at 100,800 spheres, docs/performance.md, sixteenth session).
+  motion::ContactSums* __restrict sums = ball_sums_.data();
+  const auto v4 = [](const Vec3& v) __attribute__((always_inline)) { return motion::V4{v.x, v.y, v.z, 0.0}; };
   // Prefetch distances in rows (the pass runs down the rows; below). The row columns run downwards,
   // and the hardware prefetcher follows descending streams poorly: perf put a fifth of the pair
   // loop on the first loads of the history, parameter and flag columns. Asking for the history and
@@ -921,12 +932,13 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
   // (b beyond this thread's range: into `crossing`, see force_pass), and the stiffness terms.
   auto add_to_balls = [&](std::size_t a, std::size_t b, const Vec3& force, const Vec3& moment1, const Vec3& moment2,
                           double k_tran, double k_shear, double gap) __attribute__((always_inline)) {
-    ball_force[a] -= force;
-    ball_moment[a] += moment1;
+    const motion::V4 f = v4(force);
+    sums[a].force -= f;
+    sums[a].moment += v4(moment1);
     if (want_stiffness) add_stiffness(k_tran, k_shear, kin[a].radius, gap, ball_k_tran_[a], ball_k_rot_[a]);
     if (b < range_end) {
-      ball_force[b] += force;
-      ball_moment[b] += moment2;
+      sums[b].force += f;
+      sums[b].moment += v4(moment2);
       if (want_stiffness) add_stiffness(k_tran, k_shear, kin[b].radius, gap, ball_k_tran_[b], ball_k_rot_[b]);
     } else {
       crossing.push_back({static_cast<std::uint32_t>(b), force, moment2, k_tran, k_shear, gap});
@@ -970,8 +982,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
   for (std::size_t a = a1; a-- > a0;) {
     // Ball a's sums start here: its own rows come first in its order, and rows (x, a) with x < a
     // come later.
-    ball_force[a] = Vec3{};
-    ball_moment[a] = Vec3{};
+    sums[a] = motion::ContactSums{};
     if (want_stiffness) ball_k_tran_[a] = ball_k_rot_[a] = 0.0;
     const BallKin& ka = kin[a];
     if (far && a >= kPrefetchBalls) {
@@ -982,8 +993,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
       const char* record = reinterpret_cast<const char*>(kin + ahead);
       __builtin_prefetch(record);
       __builtin_prefetch(record + 64);
-      __builtin_prefetch(ball_force + ahead, 1);
-      __builtin_prefetch(ball_moment + ahead, 1);
+      __builtin_prefetch(sums + ahead, 1);
       __builtin_prefetch(first_rows_.data() + ahead);
       if (live) {
         // Its row ranges, those of the ball eight places further (read here next time), and the
@@ -1011,8 +1021,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
             const char* ahead = reinterpret_cast<const char*>(kin + ahead_ball);
             __builtin_prefetch(ahead);
             __builtin_prefetch(ahead + 64);
-            __builtin_prefetch(ball_force + ahead_ball, 1);
-            __builtin_prefetch(ball_moment + ahead_ball, 1);
+            __builtin_prefetch(sums + ahead_ball, 1);
           }
           if (k >= kPrefetchColumns) {  // the history and the parameters
             const std::size_t r = row_at(k - kPrefetchColumns);
@@ -1319,6 +1328,8 @@ void Simulation::force_pass(double dt) {
   // descending row order, then its wall rows (first_rows_, force_block, collect_forces). So results
   // depend neither on the blocks (ContactBatch::pad_lanes) nor on the thread count. The first
   // failing row is found by a min-reduction, so the outcome does not depend on the thread count.
+  if (ball_sums_.size() != n) ball_sums_.resize(n);
+  sums_current_ = false;  // (until collect_forces has added every share)
   const std::size_t block = std::max<std::size_t>(1, balls_per_block);
   std::size_t bad_row = rows;
   std::int64_t batched = 0;
@@ -1440,12 +1451,12 @@ void Simulation::collect_forces() {
   // ranges from the last down, each thread's list in the order it was made), then each ball's wall
   // rows in row order. Rows that are not active contacts hold zero force and moment.
   const bool want_stiffness = settings.auto_timestep || settings.density_scaling;
-  Vec3* __restrict ball_force = balls.contact_force.data();
-  Vec3* __restrict ball_moment = balls.contact_moment.data();
+  motion::ContactSums* __restrict sums = ball_sums_.data();
+  const auto v4 = [](const Vec3& v) { return motion::V4{v.x, v.y, v.z, 0.0}; };
   for (std::size_t t = crossing_.size(); t-- > 0;)
     for (const CrossShare& s : crossing_[t]) {
-      ball_force[s.b] += s.force;
-      ball_moment[s.b] += s.moment;
+      sums[s.b].force += v4(s.force);
+      sums[s.b].moment += v4(s.moment);
       if (want_stiffness)
         add_stiffness(s.k_tran, s.k_shear, balls.radius[s.b], s.gap, ball_k_tran_[s.b], ball_k_rot_[s.b]);
     }
@@ -1457,8 +1468,8 @@ void Simulation::collect_forces() {
   // Each wall row: the end of its ball's sums, and the wall's sums (both in row order).
   for (std::uint32_t c : wall_rows_) {
     const ContactKey& k = contacts.key[c];
-    ball_force[k.a] -= contacts.force[c];
-    ball_moment[k.a] += share_moment_[c];
+    sums[k.a].force -= v4(contacts.force[c]);
+    sums[k.a].moment += v4(share_moment_[c]);
     if (want_stiffness) add_row_stiffness(c, balls.radius[k.a], ball_k_tran_[k.a], ball_k_rot_[k.a]);
     if (!contacts.active[c]) continue;
     Wall& w = walls.walls[k.b];
@@ -1470,6 +1481,22 @@ void Simulation::collect_forces() {
     ++w.active_contacts;
   }
   stiffness_ready_ = want_stiffness;
+  // The BallStore's columns of the sums on the passes someone may read them after (as the reported
+  // contact columns); the law of motion reads ball_sums_ itself.
+  sums_current_ = true;
+  sum_columns_stale_ = true;
+  if (write_results_) sync_sum_columns();
+}
+
+void Simulation::sync_sum_columns() {
+  if (!sum_columns_stale_) return;
+  const std::size_t n = std::min(balls.size(), ball_sums_.size());
+#pragma omp parallel for schedule(static) if (n > kParallelMin)
+  for (std::size_t i = 0; i < n; ++i) {
+    motion::store(balls.contact_force[i], ball_sums_[i].force);
+    motion::store(balls.contact_moment[i], ball_sums_[i].moment);
+  }
+  sum_columns_stale_ = false;
 }
 
 void Simulation::add_row_stiffness(std::size_t c, double radius, double& k_tran, double& k_rot) const {

@@ -21,6 +21,7 @@
 #include "hilldem/contact/contact_store.hpp"
 #include "hilldem/engine/contact_batch.hpp"
 #include "hilldem/models/model_table.hpp"
+#include "hilldem/motion/ball_step.hpp"
 #include "hilldem/motion/law_of_motion.hpp"
 
 namespace hilldem {
@@ -175,6 +176,7 @@ class Simulation {
   // bodies by hand.
   void invalidate_forces() {
     forces_ready_ = false;
+    sums_current_ = false;
     body_terms_ready_ = false;
     rebuild_needed_ = true;
   }
@@ -349,6 +351,18 @@ class Simulation {
   // lag behind while columns_stale_ (only while records_current_).
   bool records_current_ = false;
   bool columns_stale_ = false;
+  // Each ball's contact force and moment sums [N], [N m], as the force pass adds them up (one line a
+  // ball, motion::ContactSums). The law of motion reads them while sums_current_ (from the end of a
+  // force pass until a restore or invalidate_forces(); a restored run moves with the columns it
+  // restored). The BallStore's contact_force and contact_moment columns are written from them on
+  // watched passes, and lag behind while sum_columns_stale_ (sync_sum_columns, sync_ball_columns).
+  std::vector<motion::ContactSums> ball_sums_;
+  bool sums_current_ = false;
+  bool sum_columns_stale_ = false;
+  void sync_sum_columns();
+  const motion::ContactSums* contact_sums() const {
+    return sums_current_ && ball_sums_.size() == balls.size() ? ball_sums_.data() : nullptr;
+  }
   // A bound on the largest travel of a ball since the neighbour list was made [m]: exact after
   // rebuild_if_needed's pass over the positions (0 at a rebuild), then grown by each record motion
   // by the step's largest |V| Δt (motion_travel_known_: for this step's rebuild_if_needed). The
@@ -395,6 +409,7 @@ class Simulation {
   // position_at_live_ [m]. While no ball has moved more than live_slack_ [m] since, a pair on
   // neither list is still beyond proximity, so new contacts come only from live or near rows.
   std::vector<std::uint32_t> live_rows_;
+
   std::vector<std::uint32_t> live_first_;
   // The near rows: per ball (near_first_), in row order, its hill neighbour pairs within proximity +
   // 2 live_slack_ when the list was made. A ball with one that is a contact or within reach visits

@@ -19,6 +19,13 @@ using M4 = std::int64_t __attribute__((vector_size(32)));
 HILLDEM_INLINE V4 load(const Vec3& v) { return V4{v.x, v.y, v.z, 0.0}; }
 HILLDEM_INLINE void store(Vec3& v, V4 x) { v.x = x[0], v.y = x[1], v.z = x[2]; }
 
+// A ball's contact force and moment sums [N], [N m] as the force pass adds them up (Simulation): one
+// cache line, each vector's fourth lane +0.0, so that a row's share into a ball is one vector
+// operation per sum.
+struct alignas(64) ContactSums {
+  V4 force, moment;
+};
+
 // F + F_d with F_d(i) = −α |F(i)| sign(V(i)) per lane (spec §4). Without branches: in a bed at rest
 // the signs of the velocity components are random, and a branch on each was mispredicted about every
 // other time. sign ∈ {1, −1, 0} exactly (a true comparison is −1 in its lane).
@@ -46,22 +53,22 @@ HILLDEM_INLINE M4 fixed_lanes(FixityMask fix, int d0) {
   return m;
 }
 
-// Ball i's velocity v and spin w from t−Δt/2 to t+Δt/2 with its forces at t (the BallStore's sums,
-// m g, the applied loads), then its position x to t+Δt. x, v and w come in and go out through the
+// Ball i's velocity v and spin w from t−Δt/2 to t+Δt/2 with its forces at t (the sums of its contact
+// forces and moments, m g, the applied loads), then its position x to t+Δt. x, v and w come in and go out through the
 // caller (a column or a record), and so do the mass m [kg] and inertia I [kg m²] (m g uses m);
 // inertial_mass/inertial_inertia: density scaling's, or null. kApplied = false: every applied force
 // and moment is known to be +0.0 (bit for bit), and +0.0 is added in their place, the same sums
 // without their two loads.
 template <bool kApplied = true>
 HILLDEM_INLINE void step_ball(const BallStore& balls, std::size_t i, V4 gravity, double alpha, double dt, double mass,
-                              double inertia, const double* inertial_mass, const double* inertial_inertia, V4& x,
-                              V4& v, V4& w) {
+                              double inertia, const double* inertial_mass, const double* inertial_inertia,
+                              V4 contact_force, V4 contact_moment, V4& x, V4& v, V4& w) {
   const FixityMask fix = balls.fixity[i];
   // unbalanced_force(), unbalanced_moment()
   const V4 applied_f = kApplied ? load(balls.applied_force[i]) : V4{};
   const V4 applied_m = kApplied ? load(balls.applied_moment[i]) : V4{};
-  const V4 f = load(balls.contact_force[i]) + gravity * mass + applied_f;
-  const V4 mo = load(balls.contact_moment[i]) + applied_m;
+  const V4 f = contact_force + gravity * mass + applied_f;
+  const V4 mo = contact_moment + applied_m;
   const double inv_m = 1.0 / (inertial_mass ? inertial_mass[i] : mass);
   const double inv_i = 1.0 / (inertial_inertia ? inertial_inertia[i] : inertia);
   // ΔV = (F + F_d)/m Δt, then x += V Δt (velocities at half steps)
