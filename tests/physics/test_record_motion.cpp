@@ -202,7 +202,7 @@ double worst_force_sum_error(const Simulation& sim) {
 }
 
 // The settled bed of `hilldem bench` (11,200 grains, ≈ 4.7 contacts each, a floor, periodic in x and
-// y; on two threads, rows whose second ball lies in the other thread's range).
+// y; with more than one thread, rows whose second ball lies in another thread's range).
 TEST(Motion, ForceColumnsAreTheRowsSumsWheneverSomeoneLooks) {
   const Packing bed = read_packing(HILLDEM_SOURCE_DIR "/bench/bed_settled.data", PackingFormat::Lammps);
   for (const bool records : {true, false}) {

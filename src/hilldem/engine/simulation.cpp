@@ -903,8 +903,9 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
   const ContactKey* keys = contacts.key.data();
   // Each ball's force and moment sums in one line, each a vector with a +0.0 fourth lane
   // (motion::ContactSums): a row's share into a ball is one vector operation per sum where it was
-  // three scalar ones. The same additions component by component, so the same bits (1.04 x against
-  // two Vec3 columns at 100,800 spheres, docs/performance.md, sixteenth session).
+  // three scalar ones. The same additions component by component, so the same bits (≈ 1.04-1.06 x
+  // against two Vec3 columns, binaries in turn at 100,800 spheres; docs/performance.md, sixteenth
+  // session).
   motion::ContactSums* __restrict sums = ball_sums_.data();
   const auto v4 = [](const Vec3& v) __attribute__((always_inline)) { return motion::V4{v.x, v.y, v.z, 0.0}; };
   // Prefetch distances in rows (the pass runs down the rows; below). The row columns run downwards,

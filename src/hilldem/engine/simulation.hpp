@@ -409,7 +409,6 @@ class Simulation {
   // position_at_live_ [m]. While no ball has moved more than live_slack_ [m] since, a pair on
   // neither list is still beyond proximity, so new contacts come only from live or near rows.
   std::vector<std::uint32_t> live_rows_;
-
   std::vector<std::uint32_t> live_first_;
   // The near rows: per ball (near_first_), in row order, its hill neighbour pairs within proximity +
   // 2 live_slack_ when the list was made. A ball with one that is a contact or within reach visits

@@ -54,9 +54,9 @@ HILLDEM_INLINE M4 fixed_lanes(FixityMask fix, int d0) {
 }
 
 // Ball i's velocity v and spin w from t−Δt/2 to t+Δt/2 with its forces at t (the sums of its contact
-// forces and moments, m g, the applied loads), then its position x to t+Δt. x, v and w come in and go out through the
-// caller (a column or a record), and so do the mass m [kg] and inertia I [kg m²] (m g uses m);
-// inertial_mass/inertial_inertia: density scaling's, or null. kApplied = false: every applied force
+// forces and moments, m g, the applied loads), then its position x to t+Δt. x, v and w come in and
+// go out through the caller (a column or a record), and so do the contact sums and the mass m [kg]
+// and inertia I [kg m²] (m g uses m); inertial_mass/inertial_inertia: density scaling's, or null. kApplied = false: every applied force
 // and moment is known to be +0.0 (bit for bit), and +0.0 is added in their place, the same sums
 // without their two loads.
 template <bool kApplied = true>
