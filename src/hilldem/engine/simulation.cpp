@@ -907,7 +907,6 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
   // against two Vec3 columns, binaries in turn at 100,800 spheres; docs/performance.md, sixteenth
   // session).
   motion::ContactSums* __restrict sums = ball_sums_.data();
-  const auto v4 = [](const Vec3& v) __attribute__((always_inline)) { return motion::V4{v.x, v.y, v.z, 0.0}; };
   // Prefetch distances in rows (the pass runs down the rows; below). The row columns run downwards,
   // and the hardware prefetcher follows descending streams poorly: perf put a fifth of the pair
   // loop on the first loads of the history, parameter and flag columns. Asking for the history and
@@ -933,13 +932,13 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
   // (b beyond this thread's range: into `crossing`, see force_pass), and the stiffness terms.
   auto add_to_balls = [&](std::size_t a, std::size_t b, const Vec3& force, const Vec3& moment1, const Vec3& moment2,
                           double k_tran, double k_shear, double gap) __attribute__((always_inline)) {
-    const motion::V4 f = v4(force);
+    const motion::V4 f = motion::load(force);
     sums[a].force -= f;
-    sums[a].moment += v4(moment1);
+    sums[a].moment += motion::load(moment1);
     if (want_stiffness) add_stiffness(k_tran, k_shear, kin[a].radius, gap, ball_k_tran_[a], ball_k_rot_[a]);
     if (b < range_end) {
       sums[b].force += f;
-      sums[b].moment += v4(moment2);
+      sums[b].moment += motion::load(moment2);
       if (want_stiffness) add_stiffness(k_tran, k_shear, kin[b].radius, gap, ball_k_tran_[b], ball_k_rot_[b]);
     } else {
       crossing.push_back({static_cast<std::uint32_t>(b), force, moment2, k_tran, k_shear, gap});
@@ -1453,11 +1452,10 @@ void Simulation::collect_forces() {
   // rows in row order. Rows that are not active contacts hold zero force and moment.
   const bool want_stiffness = settings.auto_timestep || settings.density_scaling;
   motion::ContactSums* __restrict sums = ball_sums_.data();
-  const auto v4 = [](const Vec3& v) { return motion::V4{v.x, v.y, v.z, 0.0}; };
   for (std::size_t t = crossing_.size(); t-- > 0;)
     for (const CrossShare& s : crossing_[t]) {
-      sums[s.b].force += v4(s.force);
-      sums[s.b].moment += v4(s.moment);
+      sums[s.b].force += motion::load(s.force);
+      sums[s.b].moment += motion::load(s.moment);
       if (want_stiffness)
         add_stiffness(s.k_tran, s.k_shear, balls.radius[s.b], s.gap, ball_k_tran_[s.b], ball_k_rot_[s.b]);
     }
@@ -1469,8 +1467,8 @@ void Simulation::collect_forces() {
   // Each wall row: the end of its ball's sums, and the wall's sums (both in row order).
   for (std::uint32_t c : wall_rows_) {
     const ContactKey& k = contacts.key[c];
-    sums[k.a].force -= v4(contacts.force[c]);
-    sums[k.a].moment += v4(share_moment_[c]);
+    sums[k.a].force -= motion::load(contacts.force[c]);
+    sums[k.a].moment += motion::load(share_moment_[c]);
     if (want_stiffness) add_row_stiffness(c, balls.radius[k.a], ball_k_tran_[k.a], ball_k_rot_[k.a]);
     if (!contacts.active[c]) continue;
     Wall& w = walls.walls[k.b];
