@@ -14,6 +14,7 @@ Command add_bench_command(CLI::App& app) {
   auto o = std::make_shared<BedBenchOptions>();
   auto settle_out = std::make_shared<std::string>();
   auto memory = std::make_shared<bool>(false);
+  auto caches = std::make_shared<bool>(false);
   auto* bench = app.add_subcommand(
       "bench", "Time the dense bed of bench/ (hill model, periodic x-y, floor, gravity, dt 1e-6 s); prints one line");
   bench->add_option("--data", o->data, "LAMMPS data file of the bed (default bench/bed_settled.data)");
@@ -37,11 +38,20 @@ Command add_bench_command(CLI::App& app) {
                   "instead of timing the bed: the memory bandwidth of one core in GB/s (STREAM copy and triad, "
                   "the triad's real traffic with write-allocate, and a read-modify-write update; 3 x 256 MiB), "
                   "the hardware limit of docs/performance.md");
+  bench->add_flag("--caches", *caches,
+                  "instead of timing the bed: what one core sees at working sets from 256 KiB to 256 MiB, one line "
+                  "each: a streaming read-modify-write in GB/s and the latency of a load at a random line in ns "
+                  "(why a bed whose step data fit in the caches runs faster per particle; docs/performance.md)");
   bench->add_option("--settle", *settle_out,
                     "instead of timing: settle the --data bed under hilldem's laws and write it to this file");
-  return {bench, [o, settle_out, memory] {
+  return {bench, [o, settle_out, memory, caches] {
             if (*memory) {
               std::cout << measure_memory_bandwidth().line() << std::endl;
+              return 0;
+            }
+            if (*caches) {
+              for (const CacheLevel& level : measure_cache_levels(default_cache_sweep()))
+                std::cout << level.line() << std::endl;
               return 0;
             }
             BedBenchOptions opt = *o;

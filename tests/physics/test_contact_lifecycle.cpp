@@ -56,6 +56,24 @@ TEST(ContactLifecycle, NonFinitePositionStopsTheCycle) {
   }
 }
 
+// The same before the first list is made, where no travel is measured: the neighbour list stops with
+// the ball's name, not in the cell grid (a fuzzed checkpoint got there with a non-finite position,
+// and the grid's cell count became a cast of NaN to an integer: fuzz/corpus/checkpoint/
+// finding_nan_cell_count.hdc).
+TEST(ContactLifecycle, NonFinitePositionStopsTheFirstNeighbourList) {
+  for (const double bad : {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()}) {
+    Simulation sim = pair_apart();
+    sim.balls.position[1].z = bad;
+    try {
+      sim.update_forces();  // the first list, and the forces, without a step
+      FAIL() << "a position of " << bad << " went unnoticed";
+    } catch (const RunError& e) {
+      EXPECT_NE(std::string(e.what()).find("ball 2 has a non-finite position at step 0"), std::string::npos)
+          << e.what();
+    }
+  }
+}
+
 // Two overlapping balls sliding past each other at 0.1 m/s for n steps.
 Simulation sliding_pair(bool track) {
   Simulation sim = pair_apart();

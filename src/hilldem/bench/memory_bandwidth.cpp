@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <random>
 #include <vector>
 
 namespace hilldem {
@@ -40,6 +41,83 @@ MemoryBandwidth measure_memory_bandwidth(std::size_t array_bytes, int passes) {
   // (a and c are read back, so the loops cannot be dropped)
   if (a[n / 2] < 0.0 || c[n / 3] < 0.0) r.copy = 0.0;
   return r;
+}
+
+std::string CacheLevel::line() const {
+  return fmt::format("working_set_kib={} update_gb_per_s={:.1f} random_load_ns={:.1f}", working_set >> 10,
+                     update / 1e9, random_load * 1e9);
+}
+
+std::vector<std::size_t> default_cache_sweep() {
+  std::vector<std::size_t> sizes;
+  for (std::size_t kib = 256; kib <= (std::size_t{256} << 10); kib *= 2) sizes.push_back(kib << 10);
+  return sizes;
+}
+
+std::vector<std::uint32_t> random_cycle(std::size_t lines, std::uint64_t seed) {
+  // Sattolo's shuffle of 0..lines-1 (each element swapped with one strictly before it) gives a
+  // permutation with a single cycle: following next[i] visits every line once before it returns, so
+  // no short loop of lines stays in a small cache. (With the swap partner drawn up to i itself, the
+  // Fisher-Yates shuffle, the permutation has several cycles: test CacheSweep.*.)
+  std::vector<std::uint32_t> next(lines);
+  for (std::size_t i = 0; i < lines; ++i) next[i] = static_cast<std::uint32_t>(i);
+  std::mt19937_64 rng(seed);
+  for (std::size_t i = lines; i-- > 1;) {
+    std::uniform_int_distribution<std::size_t> pick(0, i - 1);
+    std::swap(next[i], next[pick(rng)]);
+  }
+  return next;
+}
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+}  // namespace
+
+std::vector<CacheLevel> measure_cache_levels(const std::vector<std::size_t>& working_sets, double seconds_per_size) {
+  constexpr std::size_t kLine = 64;
+  std::vector<CacheLevel> out;
+  for (const std::size_t bytes : working_sets) {
+    CacheLevel level;
+    const std::size_t lines = std::max<std::size_t>(2, bytes / kLine);
+    level.working_set = lines * kLine;
+    // Streaming: two arrays of half the set each.
+    {
+      const std::size_t n = level.working_set / 2 / sizeof(double);
+      std::vector<double> a(n, 1.0), b(n, 0.5);
+      const double s = 0.999;
+      const auto t_all = Clock::now();
+      for (int pass = 0; pass < 3 || seconds_since(t_all) < 0.5 * seconds_per_size; ++pass) {
+        double* __restrict pa = a.data();
+        const double* __restrict pb = b.data();
+        const auto t0 = Clock::now();
+        for (std::size_t i = 0; i < n; ++i) pa[i] = s * pa[i] + pb[i];
+        const double t = seconds_since(t0);
+        if (t > 0.0) level.update = std::max(level.update, 24.0 * static_cast<double>(n) / t);
+      }
+      if (a[n / 2] < 0.0) level.update = 0.0;  // (read back, so the loop cannot be dropped)
+    }
+    // Latency: one index per line, the next line of the cycle in the line's first four bytes.
+    {
+      const std::vector<std::uint32_t> next = random_cycle(lines);
+      std::vector<std::uint32_t> mem(lines * (kLine / sizeof(std::uint32_t)));
+      for (std::size_t i = 0; i < lines; ++i) mem[i * (kLine / sizeof(std::uint32_t))] = next[i];
+      const std::uint32_t* m = mem.data();
+      std::uint32_t p = 0;
+      for (std::size_t k = 0; k < lines; ++k) p = m[std::size_t{p} * (kLine / sizeof(std::uint32_t))];  // (warm)
+      const std::size_t hops = 1u << 20;
+      const auto t_all = Clock::now();
+      level.random_load = 1.0;
+      for (int pass = 0; pass < 2 || seconds_since(t_all) < 0.5 * seconds_per_size; ++pass) {
+        const auto t0 = Clock::now();
+        for (std::size_t k = 0; k < hops; ++k) p = m[std::size_t{p} * (kLine / sizeof(std::uint32_t))];
+        level.random_load = std::min(level.random_load, seconds_since(t0) / static_cast<double>(hops));
+      }
+      if (p == lines) level.random_load = 0.0;  // (never: p is a line index; keeps the chase)
+    }
+    out.push_back(level);
+  }
+  return out;
 }
 
 }  // namespace hilldem

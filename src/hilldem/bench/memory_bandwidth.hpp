@@ -8,7 +8,9 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
+#include <vector>
 
 namespace hilldem {
 
@@ -22,5 +24,29 @@ struct MemoryBandwidth {
 
 // Three arrays of `array_bytes` each (default 256 MiB), `passes` timed passes of each loop.
 MemoryBandwidth measure_memory_bandwidth(std::size_t array_bytes = std::size_t{256} << 20, int passes = 5);
+
+// What one core sees at one working-set size: why a bed whose step data fit in the caches runs
+// faster per particle than one whose data do not (docs/performance.md, seventeenth session). Two
+// figures per size, one thread, best of several passes:
+// - a streaming read-modify-write (a = s a + b over two arrays of half the size each, every byte
+//   counted), the way the force pass walks its row columns;
+// - the latency of a dependent load at a random line of the set (a pointer chase over one cycle
+//   through all its lines), the way a neighbour's record is first met when nothing asked for it.
+struct CacheLevel {
+  std::size_t working_set = 0;  // [B]
+  double update = 0.0;          // [B/s]
+  double random_load = 0.0;     // [s] per dependent load
+  std::string line() const;     // one machine-readable line
+};
+
+// The sizes of `working_sets` [B], each measured for about `seconds_per_size` [s].
+std::vector<CacheLevel> measure_cache_levels(const std::vector<std::size_t>& working_sets,
+                                             double seconds_per_size = 0.3);
+// The default sweep: 256 KiB to 256 MiB in powers of two.
+std::vector<std::size_t> default_cache_sweep();
+
+// The chase's order: next[i] is the line after line i, one cycle through all `lines` lines in a
+// random order (Sattolo's shuffle), from a fixed seed.
+std::vector<std::uint32_t> random_cycle(std::size_t lines, std::uint64_t seed = 1);
 
 }  // namespace hilldem

@@ -77,7 +77,10 @@ std::vector<PairCandidate> find_pair_candidates(const std::vector<Vec3>& positio
   auto size_dims = [&] {
     double total = 1.0;
     for (int d = 0; d < 3; ++d) {
-      const double cells = std::min((hi[d] - lo[d]) / cell, 1e15);
+      // (NaN, from a non-finite extent or reach, counts as no extent: a cast of NaN to an integer is
+      // undefined; callers reject non-finite positions with a clear message, Simulation::rebuild.)
+      const double ratio = (hi[d] - lo[d]) / cell;
+      const double cells = ratio >= 0.0 ? std::min(ratio, 1e15) : 0.0;
       if (box.periodic[d]) {
         // Whole number of cells across the period, each at least `cell` wide.
         dims[d] = std::max(1L, static_cast<long>(std::floor(cells)));

@@ -424,6 +424,16 @@ void Simulation::rebuild_if_needed() {
 
 void Simulation::rebuild(double proximity) {
   wrap_positions();
+  // A ball that has flown off to infinity (a blow-up: Δt too large, or a state that cannot be
+  // integrated) has no cell: stop here with the ball and the step, as the force pass does for a
+  // non-finite force (which would come only after the list).
+  for (std::size_t i = 0; i < balls.size(); ++i) {
+    const Vec3& x = balls.position[i];
+    if (!std::isfinite(x.x + x.y + x.z + balls.radius[i]))
+      throw RunError("ball " + std::to_string(balls.id[i]) + " has a non-finite position at step " +
+                     std::to_string(steps) + " (" + std::to_string(x.x) + ", " + std::to_string(x.y) + ", " +
+                     std::to_string(x.z) + " m): the run is unstable; reduce the time step");
+  }
   const double reach = proximity + skin();
   std::vector<PairCandidate> candidates = find_pair_candidates(balls.position, balls.radius, reach, settings.box);
   std::vector<ContactKey> keys;
