@@ -16,6 +16,18 @@ std::string MemoryBandwidth::line() const {
                      array_bytes >> 20, copy / 1e9, triad / 1e9, triad * (32.0 / 24.0) / 1e9, update / 1e9);
 }
 
+namespace {
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+// One pass of the update a = s a + b over n elements; returns its time [s] (24 B moved per element,
+// every byte counted: each line written was read).
+double timed_update(double* __restrict a, const double* __restrict b, std::size_t n, double s) {
+  const auto t0 = Clock::now();
+  for (std::size_t i = 0; i < n; ++i) a[i] = s * a[i] + b[i];
+  return seconds_since(t0);
+}
+}  // namespace
+
 MemoryBandwidth measure_memory_bandwidth(std::size_t array_bytes, int passes) {
   const std::size_t n = array_bytes / sizeof(double);
   std::vector<double> a(n, 1.0), b(n, 2.0), c(n, 0.5);  // (touched once here: the pages are mapped)
@@ -32,11 +44,10 @@ MemoryBandwidth measure_memory_bandwidth(std::size_t array_bytes, int passes) {
     const auto t1 = std::chrono::steady_clock::now();
     for (std::size_t i = 0; i < n; ++i) pa[i] = pb[i] + s * pc[i];
     const auto t2 = std::chrono::steady_clock::now();
-    for (std::size_t i = 0; i < n; ++i) pc[i] = s * pc[i] + pb[i];
-    const auto t3 = std::chrono::steady_clock::now();
+    const double t_update = timed_update(pc, pb, n, s);
     r.copy = std::max(r.copy, rate(16.0 * static_cast<double>(n), t0, t1));
     r.triad = std::max(r.triad, rate(24.0 * static_cast<double>(n), t1, t2));
-    r.update = std::max(r.update, rate(24.0 * static_cast<double>(n), t2, t3));
+    if (t_update > 0.0) r.update = std::max(r.update, 24.0 * static_cast<double>(n) / t_update);
   }
   // (a and c are read back, so the loops cannot be dropped)
   if (a[n / 2] < 0.0 || c[n / 3] < 0.0) r.copy = 0.0;
@@ -69,13 +80,9 @@ std::vector<std::uint32_t> random_cycle(std::size_t lines, std::uint64_t seed) {
   return next;
 }
 
-namespace {
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-}  // namespace
-
 std::vector<CacheLevel> measure_cache_levels(const std::vector<std::size_t>& working_sets, double seconds_per_size) {
   constexpr std::size_t kLine = 64;
+  constexpr std::size_t kStride = kLine / sizeof(std::uint32_t);  // indices a line
   std::vector<CacheLevel> out;
   for (const std::size_t bytes : working_sets) {
     CacheLevel level;
@@ -88,11 +95,7 @@ std::vector<CacheLevel> measure_cache_levels(const std::vector<std::size_t>& wor
       const double s = 0.999;
       const auto t_all = Clock::now();
       for (int pass = 0; pass < 3 || seconds_since(t_all) < 0.5 * seconds_per_size; ++pass) {
-        double* __restrict pa = a.data();
-        const double* __restrict pb = b.data();
-        const auto t0 = Clock::now();
-        for (std::size_t i = 0; i < n; ++i) pa[i] = s * pa[i] + pb[i];
-        const double t = seconds_since(t0);
+        const double t = timed_update(a.data(), b.data(), n, s);
         if (t > 0.0) level.update = std::max(level.update, 24.0 * static_cast<double>(n) / t);
       }
       if (a[n / 2] < 0.0) level.update = 0.0;  // (read back, so the loop cannot be dropped)
@@ -100,17 +103,17 @@ std::vector<CacheLevel> measure_cache_levels(const std::vector<std::size_t>& wor
     // Latency: one index per line, the next line of the cycle in the line's first four bytes.
     {
       const std::vector<std::uint32_t> next = random_cycle(lines);
-      std::vector<std::uint32_t> mem(lines * (kLine / sizeof(std::uint32_t)));
-      for (std::size_t i = 0; i < lines; ++i) mem[i * (kLine / sizeof(std::uint32_t))] = next[i];
+      std::vector<std::uint32_t> mem(lines * kStride);
+      for (std::size_t i = 0; i < lines; ++i) mem[i * kStride] = next[i];
       const std::uint32_t* m = mem.data();
       std::uint32_t p = 0;
-      for (std::size_t k = 0; k < lines; ++k) p = m[std::size_t{p} * (kLine / sizeof(std::uint32_t))];  // (warm)
+      for (std::size_t k = 0; k < lines; ++k) p = m[std::size_t{p} * kStride];  // (warm)
       const std::size_t hops = 1u << 20;
       const auto t_all = Clock::now();
       level.random_load = 1.0;
       for (int pass = 0; pass < 2 || seconds_since(t_all) < 0.5 * seconds_per_size; ++pass) {
         const auto t0 = Clock::now();
-        for (std::size_t k = 0; k < hops; ++k) p = m[std::size_t{p} * (kLine / sizeof(std::uint32_t))];
+        for (std::size_t k = 0; k < hops; ++k) p = m[std::size_t{p} * kStride];
         level.random_load = std::min(level.random_load, seconds_since(t0) / static_cast<double>(hops));
       }
       if (p == lines) level.random_load = 0.0;  // (never: p is a line index; keeps the chase)

@@ -379,8 +379,8 @@ void Simulation::rebuild_if_needed() {
     // the exact check's answer without a pass over the positions (a NaN bound fails, and goes on).
     if (measured && travel_bound_ <= half && travel_bound_ + wall_travel_ <= 2.0 * half) return;
     // The largest squared travel since the rebuild [m²], exactly; a NaN wins (not std::max, which
-    // would drop it). Parallel: the maximum does not depend on the order, and any NaN ends the run
-    // below. And the largest since the live rows were made (refresh_live_rows), while they are. (The
+    // would drop it). Parallel: the maximum does not depend on the order, and a NaN asks for a rebuild,
+    // which ends the run (rebuild). And the largest since the live rows were made (refresh_live_rows), while they are. (The
     // positions from the records when the columns lag behind them.)
     const std::size_t n = balls.size();
     const bool from_records = columns_stale_;
@@ -407,13 +407,6 @@ void Simulation::rebuild_if_needed() {
     }
     live_travel_ = std::sqrt(worst_live);
     live_travel_known_ = live;
-    if (!std::isfinite(worst)) {
-      sync_ball_columns();
-      for (std::size_t i = 0; i < balls.size(); ++i)
-        if (!std::isfinite(norm2(balls.position[i])))
-          throw RunError("ball " + std::to_string(balls.id[i]) + " has a non-finite position at step " +
-                         std::to_string(steps) + ": the run is unstable; reduce the time step");
-    }
     const double ball_travel = std::sqrt(worst);
     travel_bound_ = ball_travel;  // (exact now: the record motion grows it from here)
     if (ball_travel <= half && ball_travel + wall_travel_ <= 2.0 * half) return;
@@ -423,17 +416,19 @@ void Simulation::rebuild_if_needed() {
 }
 
 void Simulation::rebuild(double proximity) {
-  wrap_positions();
   // A ball that has flown off to infinity (a blow-up: Δt too large, or a state that cannot be
   // integrated) has no cell: stop here with the ball and the step, as the force pass does for a
-  // non-finite force (which would come only after the list).
+  // non-finite force (which would come only after the list). Every list is made here, and a
+  // non-finite travel (rebuild_if_needed) always asks for one. Before the wrap, so that the message
+  // gives the position the run reached.
   for (std::size_t i = 0; i < balls.size(); ++i) {
     const Vec3& x = balls.position[i];
-    if (!std::isfinite(x.x + x.y + x.z + balls.radius[i]))
+    if (!std::isfinite(norm2(x) + balls.radius[i]))  // (|x|² overflows too: no distance is finite then)
       throw RunError("ball " + std::to_string(balls.id[i]) + " has a non-finite position at step " +
                      std::to_string(steps) + " (" + std::to_string(x.x) + ", " + std::to_string(x.y) + ", " +
                      std::to_string(x.z) + " m): the run is unstable; reduce the time step");
   }
+  wrap_positions();
   const double reach = proximity + skin();
   std::vector<PairCandidate> candidates = find_pair_candidates(balls.position, balls.radius, reach, settings.box);
   std::vector<ContactKey> keys;
