@@ -221,6 +221,50 @@ TEST(HillBatch, LiveRowsOrAllRowsGiveTheSameBits) {
   }
 }
 
+// The live rows through their records (use_live_records) or through the row columns: the same lanes
+// with the same inputs in the same order, so the same bits, dry and wet, with the row loop with and
+// without its contact branch. The run is cut into cycle() calls of 37 steps (the last step of each,
+// looked at, goes through the columns), and make_wet between them reads and changes the columns, so
+// the records' history (n̂_c, F^h_s, M) must be back in the columns after every call: they are
+// compared bit for bit at the end.
+TEST(HillBatch, LiveRecordsOrColumnsGiveTheSameBits) {
+  for (const auto& [branchless, proximity] : {std::pair{true, 0.0}, std::pair{false, 0.0}, std::pair{true, 1e-3}}) {
+    auto run = [branchless, proximity](bool records) {
+      Simulation sim = periodic_cloud();
+      sim.settings.proximity = proximity;
+      sim.use_branchless_rows = branchless;
+      sim.branchless_rows_min = 0;
+      sim.use_live_records = records;
+      for (int k = 0; k < 8; ++k) sim.cycle(37);
+      sim.make_wet(20e3, 0.5e-3);
+      for (int k = 0; k < 4; ++k) sim.cycle(37);
+      for (std::size_t i = 0; i < sim.balls.size(); ++i)  // kicks [m/s] that pull bridges apart
+        sim.balls.velocity[i] += Vec3{4.0 * static_cast<double>(i % 7) - 12.0, 3.0 * static_cast<double>(i % 5) - 6.0, 0};
+      for (int k = 0; k < 16; ++k) sim.cycle(37);
+      return sim;
+    };
+    const Simulation on = run(true), off = run(false);
+    EXPECT_GT(on.live_record_passes(), 200);
+    EXPECT_EQ(off.live_record_passes(), 0);
+    const Outcome a = outcome(on), b = outcome(off);
+    expect_same_bits(a, b);
+    EXPECT_GT(a.wet, 20u);
+    EXPECT_EQ(a.wet, b.wet);
+    EXPECT_EQ(a.ruptured, b.ruptured);
+    ASSERT_EQ(on.contacts.size(), off.contacts.size());
+    for (std::size_t c = 0; c < on.contacts.size(); ++c) {
+      EXPECT_EQ(on.contacts.exists[c], off.contacts.exists[c]) << c;
+      EXPECT_EQ(on.contacts.moisture[c], off.contacts.moisture[c]) << c;
+      for (const auto& [x, y] : {std::pair{on.contacts.normal[c], off.contacts.normal[c]},
+                                 std::pair{on.contacts.shear_state[c], off.contacts.shear_state[c]}}) {
+        EXPECT_EQ(x.x, y.x) << c;
+        EXPECT_EQ(x.y, y.y) << c;
+        EXPECT_EQ(x.z, y.z) << c;
+      }
+    }
+  }
+}
+
 // Two wet grains pulled apart: the bridge holds, then ruptures at 2 s_cr (Eq. 12), at the same step
 // either way; the contact is then deleted (inactive beyond proximity).
 TEST(HillBatch, RuptureAtTheSameStep) {
@@ -240,6 +284,45 @@ TEST(HillBatch, RuptureAtTheSameStep) {
   ASSERT_GT(batch.first, 0);
   EXPECT_EQ(batch.first, rows.first);
   EXPECT_LT(worst_position_gap(batch.second, rows.second), 1e-15);
+}
+
+// A bridge that ruptures inside a cycle() call, on a step nobody looks at, while its contact stays
+// (within the proximity), so that the rupture (M = 1) is written into the live record; the grain
+// then bounces off a wall and meets the other again. The same step of rupture and the same bits with
+// and without the records. (A stale M = 2 would rupture again at once wherever the gap is beyond the
+// bridge's reach, so only a bridge that closed again before the records were written back could
+// tell; the records are written back whenever the live list is made again, every few µm of travel.)
+TEST(HillBatch, RuptureInALiveRecordReachesTheColumns) {
+  auto run = [](bool records) {
+    Simulation sim = granite_row({0.2e-3});  // radii 5 mm, centres 10.2 mm apart
+    sim.use_live_records = records;
+    sim.settings.proximity = 20e-3;  // [m] the contact outlives its bridge
+    sim.table.rules.push_back(linear_wall_rule(500e6, 0.0));
+    Wall w;
+    w.name = "stop";
+    w.shape = WallShape::Plane;
+    w.point = {30e-3, 0, 0};
+    w.normal = {-1, 0, 0};
+    sim.walls.add(w);
+    sim.make_wet(20e3, 0.5e-3);
+    sim.balls.velocity[1] = {10.0, 0, 0};  // [m/s] apart, towards the wall
+    std::int64_t broke_at = -1;
+    for (std::int64_t k = 1; k <= 200; ++k) {
+      sim.cycle(25);
+      if (broke_at < 0 && sim.contacts.moisture[0] == Moisture::Ruptured) broke_at = k;
+    }
+    return std::make_tuple(broke_at, outcome(sim), sim.live_record_passes());
+  };
+  const auto [on_broke, on, on_passes] = run(true);
+  const auto [off_broke, off, off_passes] = run(false);
+  ASSERT_GT(on_broke, 0);
+  EXPECT_EQ(on_broke, off_broke);
+  EXPECT_GT(on_passes, 4000);
+  EXPECT_EQ(off_passes, 0);
+  EXPECT_EQ(on.ruptured, 1u);
+  EXPECT_LT(on.position[0].x, -5e-3);  // the grains met again: the returning one knocked the other away
+  EXPECT_EQ(on.position[1].x, off.position[1].x);
+  EXPECT_EQ(on.position[0].x, off.position[0].x);
 }
 
 // The linear law between grains, as in the packing phase of material genesis (E* 100 MPa, κ* 1.5,
@@ -269,6 +352,21 @@ TEST(LinearBatch, SameMotionAsTheRowByRowLaw) {
   EXPECT_GT(batch.contacts, 200u);
   EXPECT_EQ(batch.contacts, rows.contacts);
   EXPECT_LT(worst_position_gap(batch, rows), 1e-12) << worst_position_gap(batch, rows);
+}
+
+// Linear ball-ball rows are live rows too: through their records, their flags and history stay in the
+// columns (only hill rows keep theirs in the record). The same bits with and without the records.
+TEST(LinearBatch, LiveRecordsGiveTheSameBits) {
+  auto run = [](bool records) {
+    Simulation sim = falling_linear_box();
+    sim.use_live_records = records;
+    for (int k = 0; k < 10; ++k) sim.cycle(400);
+    return sim;
+  };
+  const Simulation on = run(true), off = run(false);
+  EXPECT_GT(on.live_record_passes(), 3000);
+  expect_same_bits(outcome(on), outcome(off));
+  EXPECT_GT(outcome(on).contacts, 200u);
 }
 
 // The block size of the force pass is a tuning knob: blocks of 7, 32, 128 or all 600 balls group the

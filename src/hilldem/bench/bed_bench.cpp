@@ -86,7 +86,7 @@ std::int64_t settle_bed(const std::string& in, const std::string& out, double ra
 
 const std::vector<std::string>& alternate_switches() {
   static const std::vector<std::string> names{"vector-fill", "branchless-rows", "live-rows", "speed-split",
-                                               "record-motion"};
+                                               "record-motion", "live-records"};
   return names;
 }
 
@@ -100,6 +100,7 @@ bool& switch_of(Simulation& sim, const std::string& name) {
   if (name == "live-rows") return sim.use_live_rows;
   if (name == "speed-split") return sim.use_speed_split;
   if (name == "record-motion") return sim.use_record_motion;
+  if (name == "live-records") return sim.use_live_records;
   std::string allowed;
   for (const std::string& s : alternate_switches()) allowed += (allowed.empty() ? "" : ", ") + s;
   throw InputError("bench --alternate: unknown switch '" + name + "' (allowed: " + allowed + ")");

@@ -60,12 +60,15 @@ class ContactBatch {
   // Lanes per batch: 64 lanes of every field take ≈ 30 kB, so a batch stays in the L1 cache between
   // the gather, the law and the scatter.
   static constexpr std::size_t kLanes = 64;
+  // A lane whose row has no live record (see add_if).
+  static constexpr std::uint32_t kNoSlot = 0xFFFFFFFFu;
 
   void clear() { size_ = 0; }
   bool full() const { return size_ == kLanes; }
   // A new lane for contact row `row`; returns its index. Only when !full().
   std::size_t add(std::uint32_t row) {
     row_[size_] = row;
+    slot_[size_] = kNoSlot;
     return size_++;
   }
   // A ball-ball lane for row `row`, kept only if `keep`: the slot after the last lane is written either
@@ -74,17 +77,23 @@ class ContactBatch {
   // periodic image of ball 2: the force pass fills the lanes' ball fields (kDx..kWbz, and the hill
   // terms kIr..kCs) from the balls' records when the batch is run (Simulation::fill_lanes), not row by
   // row. Only when !full().
-  void add_if(bool keep, std::uint32_t row, std::uint32_t ball1, std::uint32_t ball2, std::uint8_t image) {
+  // `slot`: the row's live record (Simulation::use_live_records), whose history the lane reads and
+  // writes instead of the row columns; kNoSlot: the columns.
+  void add_if(bool keep, std::uint32_t row, std::uint32_t ball1, std::uint32_t ball2, std::uint8_t image,
+              std::uint32_t slot = kNoSlot) {
     image_[size_] = image;
+    slot_[size_] = slot;
     ball1_[size_] = ball1;
     ball2_[size_] = ball2;
     row_[size_] = row;
     size_ += keep ? 1 : 0;
   }
   // The same, always kept.
-  void add(std::uint32_t row, std::uint32_t ball1, std::uint32_t ball2, std::uint8_t image) {
-    add_if(true, row, ball1, ball2, image);
+  void add(std::uint32_t row, std::uint32_t ball1, std::uint32_t ball2, std::uint8_t image,
+           std::uint32_t slot = kNoSlot) {
+    add_if(true, row, ball1, ball2, image, slot);
   }
+  std::uint32_t slot(std::size_t lane) const { return slot_[lane]; }
   std::uint8_t image(std::size_t lane) const { return image_[lane]; }
   std::uint32_t ball1(std::size_t lane) const { return ball1_[lane]; }
   std::uint32_t ball2(std::size_t lane) const { return ball2_[lane]; }
@@ -118,6 +127,7 @@ class ContactBatch {
   std::uint32_t ball1_[kLanes];
   std::uint32_t ball2_[kLanes];
   std::uint8_t image_[kLanes];
+  std::uint32_t slot_[kLanes];  // live record or kNoSlot
 };
 
 // The hill law of every lane over a step of dt [s]: geometry (Eqs. 2-3), relative velocity at the

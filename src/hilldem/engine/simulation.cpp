@@ -52,7 +52,11 @@ bool same_bits(const HillParams& x, const HillParams& y) { return param_bits(x) 
 
 void Simulation::cycle(std::int64_t n) {
   drop_records();  // the caller may have changed the columns since the last call
-  for (std::int64_t k = 0; k < n; ++k) step_once(k + 1 == n);
+  for (std::int64_t k = 0; k < n; ++k) {
+    steps_ahead_ = n - 1 - k;  // (whether the live records pay: force_pass)
+    step_once(k + 1 == n);
+  }
+  steps_ahead_ = 0;
 }
 
 std::int64_t Simulation::solve(double ratio, std::int64_t max_steps) {
@@ -93,6 +97,7 @@ void Simulation::step_once(bool last) {
     step_body(last);
   } catch (...) {
     sync_ball_columns();  // the state where the run stopped, for whoever catches this
+    if (live_records_ready_) sync_live_records();
     throw;
   }
 }
@@ -222,6 +227,7 @@ void Simulation::create_contact(std::size_t c, const Vec3& normal) {
 }
 
 void Simulation::refresh_param_sets() {
+  if (live_records_ready_) sync_live_records();  // (the records hold the rows' sets)
   // The distinct parameters, told apart by their bits, so that each row's set holds exactly its
   // parameters. Rows mostly share their neighbour's set: one comparison, and a map lookup only when
   // the parameters change along the rows.
@@ -416,6 +422,7 @@ void Simulation::rebuild_if_needed() {
 }
 
 void Simulation::rebuild(double proximity) {
+  if (live_records_ready_) sync_live_records();  // (the rows are made anew, their history by key)
   // A ball that has flown off to infinity (a blow-up: Δt too large, or a state that cannot be
   // integrated) has no cell: stop here with the ball and the step, as the force pass does for a
   // non-finite force (which would come only after the list). Every list is made here, and a
@@ -714,14 +721,16 @@ HILLDEM_INLINE void Simulation::store_row(std::size_t c, const RowOutcome& out, 
 }
 
 HILLDEM_INLINE void Simulation::store_kept_lane(std::size_t c, const ContactBatch& batch, std::size_t lane,
-                                               bool want_stiffness, bool reported) {
+                                               bool want_stiffness, bool reported, bool history) {
   // The columns of store_row for a contact that stays (written in the same cases). Going through a
   // RowOutcome and a RowShare cost ≈ 45 instructions a lane more (callgrind: 163 against 108, plus
   // 11 in batch_shares): the outcome's fields copied, the moments computed one lane at a time, the
   // moisture read back, the keys read again.
   using F = ContactBatch;
-  contacts.shear_state[c] = batch.get3(F::kShx, lane);
-  contacts.normal[c] = batch.get3(F::kNx, lane);
+  if (history) {
+    contacts.shear_state[c] = batch.get3(F::kShx, lane);
+    contacts.normal[c] = batch.get3(F::kNx, lane);
+  }
   if (reported) {
     contacts.force[c] = batch.get3(F::kFx, lane);
     contacts.normal_force[c] = batch.col(F::kFn)[lane];
@@ -875,6 +884,18 @@ void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
   // the parameters set for eight lanes at once: 1.000 x in cache, 16 pairs; not kept.)
   for (lane = 0; lane < n; ++lane) {
     const std::size_t c = batch.row(lane);
+    // A lane from a live record (use_live_records): the row's inputs from there.
+    const std::uint32_t slot = hill ? batch.slot(lane) : ContactBatch::kNoSlot;
+    if (slot != ContactBatch::kNoSlot) {
+      const LiveRecord& h = live_records_[slot];
+      batch.put3(F::kNox, lane, h.normal);
+      batch.put3(F::kSx, lane, h.shear);
+      const HillParams& p = hill_sets_[h.hill_set];
+      batch.col(F::kFric)[lane] = p.fric_coef, batch.col(F::kSuction)[lane] = p.suction;
+      batch.col(F::kDamp)[lane] = p.damp_con;
+      batch.col(F::kWet)[lane] = h.moisture == Moisture::Wet ? 1.0 : 0.0;
+      continue;
+    }
     batch.put3(F::kNox, lane, contacts.normal[c]);
     batch.put3(F::kSx, lane, contacts.shear_state[c]);
     if (hill) {
@@ -926,8 +947,10 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
   constexpr std::size_t kPrefetchColumns = 32;
   constexpr std::size_t kPrefetchFlags = 128;
   constexpr std::size_t kPrefetchBalls = 8;
+  constexpr std::size_t kPrefetchRecords = 64;
   const bool far = contacts.size() > (std::size_t{1} << 17);
   const bool live = live_now_;  // the rows visited: the live rows (force_pass), or all
+  const bool records = live && live_records_ready_;  // the live rows through their records
   using F = ContactBatch;
   ContactBatch& hill = scratch.hill;
   ContactBatch& linear = scratch.linear;
@@ -968,14 +991,24 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
     const double* quick = batch.col(F::kQuick);
     for (std::size_t lane = 0; lane < batch.size(); ++lane) {
       const std::size_t c = batch.row(lane);
+      const std::uint32_t slot = &batch == &hill ? batch.slot(lane) : ContactBatch::kNoSlot;
       if (quick[lane] == 0.0) {  // deleted, or a non-finite force: the general way
         RowShare share;
         store_row(c, lane_outcome(batch, lane, /*wall_row=*/false), want_stiffness, reported, share);
         add_share(c, share);
+        if (slot != ContactBatch::kNoSlot) load_live_record(slot);  // (store_row wrote the columns)
         continue;
       }
-      // The shares from the lanes.
-      store_kept_lane(c, batch, lane, want_stiffness, reported);
+      // The shares from the lanes; a live record's history into the record.
+      if (slot != ContactBatch::kNoSlot) {
+        LiveRecord& h = live_records_[slot];
+        h.shear = batch.get3(F::kShx, lane);
+        h.normal = batch.get3(F::kNx, lane);
+        if (batch.col(F::kRuptured)[lane] != 0.0) h.moisture = Moisture::Ruptured;
+        store_kept_lane(c, batch, lane, want_stiffness, reported, false);
+      } else {
+        store_kept_lane(c, batch, lane, want_stiffness, reported);
+      }
       double k_tran = 0.0, k_shear = 0.0, gap = 0.0;
       if (want_stiffness)
         k_tran = batch.col(F::kKtran)[lane], k_shear = batch.col(F::kKshear)[lane], gap = batch.col(F::kGap)[lane];
@@ -1005,8 +1038,11 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
         // records of its near pairs' second balls.
         __builtin_prefetch(live_first_.data() + ahead);
         if (ahead >= kPrefetchBalls) __builtin_prefetch(near_first_.data() + ahead - kPrefetchBalls);
+        if (records && ahead >= kPrefetchBalls)
+          __builtin_prefetch(near_records_.data() + near_first_[ahead - kPrefetchBalls]);
         for (std::size_t k = near_first_[ahead]; k < near_first_[ahead + 1]; ++k) {
-          const char* near = reinterpret_cast<const char*>(kin + keys[near_rows_[k]].b);
+          const std::size_t b = records ? near_records_[k].b : keys[near_rows_[k]].b;
+          const char* near = reinterpret_cast<const char*>(kin + b);
           __builtin_prefetch(near);
           __builtin_prefetch(near + 64);
         }
@@ -1097,15 +1133,84 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
     // made) visits all its rows: the pair is not among its live rows.
     bool full = false;
     if (live) {
-      for (std::size_t k = near_first_[a]; k < near_first_[a + 1]; ++k) {
-        const std::size_t c = near_rows_[k];
-        full |= contacts.exists[c] || within_reach(ka, keys[c].b, contacts.image[c]);
+      if (records) {
+        for (std::size_t k = near_first_[a]; k < near_first_[a + 1]; ++k) {
+          const NearRecord& q = near_records_[k];
+          full |= q.exists || within_reach(ka, q.b, q.image);
+        }
+      } else {
+        for (std::size_t k = near_first_[a]; k < near_first_[a + 1]; ++k) {
+          const std::size_t c = near_rows_[k];
+          full |= contacts.exists[c] || within_reach(ka, keys[c].b, contacts.image[c]);
+        }
       }
       full_balls += full;
     }
-    if (live && !full) {
+    if (live && !full && records) {
+      // Ball a's live rows from the last down, through their records (use_live_records): the loop of
+      // run_rows for live rows, with the record of each row in place of its nine columns. (The near
+      // check above reads the near rows' records for the same reason: with the row columns no longer
+      // streamed ahead by this loop, the near rows' flags and keys missed the cache, and the records
+      // without them ran at 0.89-0.93 x; docs/performance.md, eighteenth session.)
+      LiveRecord* rec = live_records_.data();
+      for (std::size_t k = live_first_[a + 1]; k-- > live_first_[a];) {
+        if (far) {
+          if (k >= kPrefetchRows) {  // the neighbour's record and sums, as in run_rows
+            const std::size_t ahead_ball = rec[k - kPrefetchRows].b;
+            const char* ahead = reinterpret_cast<const char*>(kin + ahead_ball);
+            __builtin_prefetch(ahead);
+            __builtin_prefetch(ahead + 64);
+            __builtin_prefetch(sums + ahead_ball, 1);
+          }
+          // One line a row (32-128 rows ahead alike; 16 was slower).
+          if (k >= kPrefetchRecords) __builtin_prefetch(rec + k - kPrefetchRecords, 1);
+        }
+        const LiveRecord& r = rec[k];
+        const std::size_t c = r.row, b = r.b;
+        if (r.model == ModelKind::Hill) {
+          if (linear.size() > 0) flush(linear);
+          if (hill.full()) flush(hill);
+          const bool exists = r.exists;
+          hill.add_if(exists, static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(a),
+                      static_cast<std::uint32_t>(b), r.image, static_cast<std::uint32_t>(k));
+          if (!exists && within_reach(ka, b, r.image)) [[unlikely]] {  // a contact again (force_row)
+            if (hill.size() > 0) flush(hill);
+            add_share(c, force_row(c, dt));
+            load_live_record(k);
+          }
+          continue;
+        }
+        // Another model (its history and flags in the columns): as run_rows.
+        const bool exists = contacts.exists[c];
+        if (!exists && !within_reach(ka, b, r.image)) continue;
+        if (!exists) {
+          if (hill.size() > 0) flush(hill);
+          if (linear.size() > 0) flush(linear);
+          add_share(c, force_row(c, dt));
+          continue;
+        }
+        if (hill.size() > 0) flush(hill);
+        if (linear.full()) flush(linear);
+        linear.add(static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b), r.image);
+      }
+    } else if (live && !full) {
       const std::uint32_t* rows = live_rows_.data();
       run_rows(live_first_[a + 1], live_first_[a], [rows](std::size_t k) -> std::size_t { return rows[k]; }, true);
+    } else if (records) {
+      // A ball that visits all its rows, through the columns: its live rows' history into them first,
+      // and back into the records (and the near rows' flags) once its lanes have run.
+      for (std::size_t k = live_first_[a]; k < live_first_[a + 1]; ++k) {
+        const LiveRecord& r = live_records_[k];
+        if (r.model != ModelKind::Hill) continue;
+        contacts.normal[r.row] = r.normal, contacts.shear_state[r.row] = r.shear;
+        contacts.moisture[r.row] = r.moisture;
+      }
+      run_rows(first_rows_[a + 1], first_rows_[a], [](std::size_t k) { return k; }, false);
+      if (hill.size() > 0) flush(hill);
+      if (linear.size() > 0) flush(linear);
+      for (std::size_t k = live_first_[a]; k < live_first_[a + 1]; ++k) load_live_record(k);
+      for (std::size_t k = near_first_[a]; k < near_first_[a + 1]; ++k)
+        near_records_[k].exists = contacts.exists[near_records_[k].row];
     } else {
       run_rows(first_rows_[a + 1], first_rows_[a], [](std::size_t k) { return k; }, false);
     }
@@ -1265,6 +1370,7 @@ void Simulation::refresh_live_rows() {
   // (slow balls), between a thousandth and a quarter of the skin. The list changes no result, only
   // how much the row loop visits; so neither does s.
   constexpr std::int64_t kLiveShort = 25, kLiveLong = 400;
+  if (live_records_ready_) sync_live_records();  // (made for the old list)
   const double skin_now = skin();
   const std::int64_t lasted = live_passes_;
   if (!(live_slack_ > 0.0) || live_slack_ > 0.25 * skin_now) live_slack_ = 0.002 * skin_now;
@@ -1323,6 +1429,59 @@ void Simulation::refresh_live_rows() {
   ++live_refreshes_;
 }
 
+void Simulation::load_live_record(std::size_t k) {
+  LiveRecord& r = live_records_[k];
+  const std::size_t c = r.row;
+  r.b = contacts.key[c].b;
+  r.hill_set = row_hill_set_[c];
+  r.image = contacts.image[c];
+  r.exists = contacts.exists[c];
+  r.model = contacts.model[c];
+  r.moisture = contacts.moisture[c];
+  r.normal = contacts.normal[c];
+  r.shear = contacts.shear_state[c];
+}
+
+void Simulation::build_live_records() {
+  const std::size_t live = live_rows_.size(), near = near_rows_.size();
+  live_records_.resize(live);
+  near_records_.resize(near);
+  const std::size_t n = balls.size();
+#pragma omp parallel for schedule(static) if (n > kParallelMin)
+  for (std::size_t a = 0; a < n; ++a) {
+    for (std::size_t k = live_first_[a]; k < live_first_[a + 1]; ++k) {
+      live_records_[k].row = live_rows_[k];
+      load_live_record(k);
+    }
+    for (std::size_t k = near_first_[a]; k < near_first_[a + 1]; ++k) {
+      const std::size_t c = near_rows_[k];
+      near_records_[k] = {static_cast<std::uint32_t>(c), contacts.key[c].b, contacts.image[c], contacts.exists[c]};
+    }
+  }
+  live_records_ready_ = true;
+}
+
+void Simulation::sync_live_records() {
+  const std::size_t n = balls.size();
+  if (live_first_.size() == n + 1 && live_first_[n] == live_records_.size()) {
+#pragma omp parallel for schedule(static) if (n > kParallelMin)
+    for (std::size_t a = 0; a < n; ++a)
+      for (std::size_t k = live_first_[a]; k < live_first_[a + 1]; ++k) {
+        const LiveRecord& r = live_records_[k];
+        if (r.model != ModelKind::Hill) continue;
+        contacts.normal[r.row] = r.normal, contacts.shear_state[r.row] = r.shear;
+        contacts.moisture[r.row] = r.moisture;
+      }
+  } else {
+    for (const LiveRecord& r : live_records_) {
+      if (r.model != ModelKind::Hill) continue;
+      contacts.normal[r.row] = r.normal, contacts.shear_state[r.row] = r.shear;
+      contacts.moisture[r.row] = r.moisture;
+    }
+  }
+  live_records_ready_ = false;
+}
+
 void Simulation::force_pass(double dt) {
   const std::size_t rows = contacts.size();
   const std::size_t n = balls.size();
@@ -1378,6 +1537,14 @@ void Simulation::force_pass(double dt) {
   if (!terms_ready || live_rows_of_ != rows || !(live_proximity_ == settings.proximity)) live_ready_ = false;
   if (live_now_ && !(live_ready_ && live_travel_known_ && live_travel_ <= live_slack_)) refresh_live_rows();
   live_travel_known_ = false;  // (measured again before the next pass)
+  // The live rows through their records (use_live_records) on the steps nobody looks at, made when
+  // at least kRecordSteps more steps follow in this cycle() call (making and writing back the records
+  // costs about half a step at 100,800 spheres, and the last step of a call is looked at).
+  constexpr std::int64_t kRecordSteps = 8;
+  const bool records = live_now_ && use_live_records && !write_results_;
+  if (live_records_ready_ && !records) sync_live_records();
+  if (records && !live_records_ready_ && steps_ahead_ >= kRecordSteps) build_live_records();
+  live_record_passes_ += live_records_ready_;
   std::size_t full_balls = 0;  // balls that visited all their rows (force_block)
 #pragma omp parallel reduction(min : bad_row) reduction(+ : batched, full_balls) if (n > kParallelMin)
   {

@@ -149,6 +149,18 @@ class Simulation {
   // Threads share the balls of the force pass in proportion to their measured speeds (the cores of a
   // shared machine do not run equally fast); false: equal work. Results do not depend on the shares.
   bool use_speed_split = true;
+  // Within a cycle() call, on the steps nobody looks at, the row loop reads and writes each live row
+  // through a record of one cache line in live-row order (its second ball, image, flags, parameter
+  // set, n̂_c and F^h_s), and each near row through a small record of its own, instead of through the
+  // row columns: one memory stream a row instead of nine. The records hold the live hill rows' history
+  // until they are written back into the columns (sync_live_records): before any step someone looks
+  // at, at the end of every cycle() call, before a rebuild or a new live list, and when a step
+  // throws, so the columns are current wherever anyone outside the force pass reads them. The same
+  // bits either way (test HillBatch.LiveRecordsOrColumnsGiveTheSameBits): 1.05-1.08 x at 100,800
+  // spheres (docs/performance.md, eighteenth session).
+  bool use_live_records = true;
+  // How many force passes ran through the live records.
+  std::int64_t live_record_passes() const { return live_record_passes_; }
   // Given shares of the work per thread (one per thread, normalised) instead: for tests, and for cores
   // of known speeds. Empty: measured (use_speed_split) or equal.
   std::vector<double> thread_shares;
@@ -276,7 +288,8 @@ class Simulation {
   RowOutcome lane_outcome(const ContactBatch& batch, std::size_t lane, bool wall_row) const;
   // store_row for a lane that batch_shares() marked kQuick (the contact stays, its force is finite):
   // the same columns, straight from the lanes. The shares come from the lanes too (kMax.., kMbx..).
-  void store_kept_lane(std::size_t c, const ContactBatch& batch, std::size_t lane, bool want_stiffness, bool reported);
+  void store_kept_lane(std::size_t c, const ContactBatch& batch, std::size_t lane, bool want_stiffness, bool reported,
+                       bool history = true);
   // What one thread reuses from block to block.
   struct BlockScratch {
     ContactBatch hill, linear;
@@ -426,6 +439,34 @@ class Simulation {
   double live_travel_ = 0.0;       // [m] the largest travel of a ball since the list (rebuild_if_needed)
   bool live_travel_known_ = false; // measured for this pass
   void refresh_live_rows();
+  // The live rows' records (use_live_records), in live-row order (live_rows_), one cache line each:
+  // what the row loop and the lanes read and write of a row. n̂_c, F^h_s and M are those of hill rows
+  // only (other models keep theirs in the columns, and their `exists` is read there too).
+  struct alignas(64) LiveRecord {
+    std::uint32_t row = 0, b = 0;  // the row; its second ball
+    std::uint32_t hill_set = 0;    // row_hill_set_
+    ImageCode image = kNoImage;
+    std::uint8_t exists = 0;
+    ModelKind model = ModelKind::Hill;
+    Moisture moisture = Moisture::Dry;
+    Vec3 normal;  // n̂_c of the last step
+    Vec3 shear;   // F^h_s [N]
+  };
+  static_assert(sizeof(LiveRecord) == 64);
+  // The near rows' records, in near-row order (near_rows_): what the near check reads.
+  struct NearRecord {
+    std::uint32_t row = 0, b = 0;
+    ImageCode image = kNoImage;
+    std::uint8_t exists = 0;
+  };
+  std::vector<LiveRecord> live_records_;
+  std::vector<NearRecord> near_records_;
+  bool live_records_ready_ = false;   // the records hold the live hill rows' history
+  std::int64_t steps_ahead_ = 0;      // steps of the current cycle() call after this one
+  std::int64_t live_record_passes_ = 0;
+  void build_live_records();
+  void load_live_record(std::size_t k);  // record k from the columns
+  void sync_live_records();              // the history back into the columns; the records dropped
 };
 
 }  // namespace hilldem
