@@ -156,8 +156,8 @@ class Simulation {
   // until they are written back into the columns (sync_live_records): before any step someone looks
   // at, at the end of every cycle() call, before a rebuild or a new live list, and when a step
   // throws, so the columns are current wherever anyone outside the force pass reads them. The same
-  // bits either way (test HillBatch.LiveRecordsOrColumnsGiveTheSameBits): 1.05-1.08 x at 100,800
-  // spheres (docs/performance.md, eighteenth session).
+  // bits either way (test HillBatch.LiveRecordsOrColumnsGiveTheSameBits): 1.07-1.08 x at 100,800
+  // spheres, 1.03-1.05 x at 11,200 (docs/performance.md, eighteenth session).
   bool use_live_records = true;
   // How many force passes ran through the live records.
   std::int64_t live_record_passes() const { return live_record_passes_; }
@@ -467,6 +467,7 @@ class Simulation {
   void build_live_records();
   void load_live_record(std::size_t k);  // record k from the columns
   void sync_live_records();              // the history back into the columns; the records dropped
+  void write_back(const LiveRecord& r);  // one record's history (hill rows) into the columns
 };
 
 }  // namespace hilldem
