@@ -882,28 +882,29 @@ void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
   }
   // The rows' own inputs, lane by lane. (Eight rows' Vec3s loaded whole and transposed as well, and
   // the parameters set for eight lanes at once: 1.000 x in cache, 16 pairs; not kept.)
+  // A hill lane's history, parameter set and M: from its live record (use_live_records), or from
+  // the row columns.
+  auto put_hill = [&](std::size_t lane, const Vec3& normal, const Vec3& shear, std::uint32_t set, Moisture m) {
+    batch.put3(F::kNox, lane, normal);
+    batch.put3(F::kSx, lane, shear);
+    const HillParams& p = hill_sets_[set];
+    batch.col(F::kFric)[lane] = p.fric_coef, batch.col(F::kSuction)[lane] = p.suction;
+    batch.col(F::kDamp)[lane] = p.damp_con;
+    batch.col(F::kWet)[lane] = m == Moisture::Wet ? 1.0 : 0.0;
+  };
   for (lane = 0; lane < n; ++lane) {
     const std::size_t c = batch.row(lane);
-    // A lane from a live record (use_live_records): the row's inputs from there.
-    const std::uint32_t slot = hill ? batch.slot(lane) : ContactBatch::kNoSlot;
-    if (slot != ContactBatch::kNoSlot) {
-      const LiveRecord& h = live_records_[slot];
-      batch.put3(F::kNox, lane, h.normal);
-      batch.put3(F::kSx, lane, h.shear);
-      const HillParams& p = hill_sets_[h.hill_set];
-      batch.col(F::kFric)[lane] = p.fric_coef, batch.col(F::kSuction)[lane] = p.suction;
-      batch.col(F::kDamp)[lane] = p.damp_con;
-      batch.col(F::kWet)[lane] = h.moisture == Moisture::Wet ? 1.0 : 0.0;
-      continue;
-    }
-    batch.put3(F::kNox, lane, contacts.normal[c]);
-    batch.put3(F::kSx, lane, contacts.shear_state[c]);
     if (hill) {
-      const HillParams& p = hill_sets_[row_hill_set_[c]];
-      batch.col(F::kFric)[lane] = p.fric_coef, batch.col(F::kSuction)[lane] = p.suction;
-      batch.col(F::kDamp)[lane] = p.damp_con;
-      batch.col(F::kWet)[lane] = contacts.moisture[c] == Moisture::Wet ? 1.0 : 0.0;
-    } else {  // the linear law's parameters are the row's (LinearMapping, LinearParams)
+      const std::uint32_t slot = batch.slot(lane);
+      if (slot != ContactBatch::kNoSlot) {
+        const LiveRecord& r = live_records_[slot];
+        put_hill(lane, r.normal, r.shear, r.hill_set, r.moisture);
+      } else {
+        put_hill(lane, contacts.normal[c], contacts.shear_state[c], row_hill_set_[c], contacts.moisture[c]);
+      }
+    } else {  // the linear law's history, and its parameters: the row's (LinearMapping, LinearParams)
+      batch.put3(F::kNox, lane, contacts.normal[c]);
+      batch.put3(F::kSx, lane, contacts.shear_state[c]);
       batch.col(F::kIr)[lane] = contacts.linear_map[c].kn;
       batch.col(F::kIm)[lane] = contacts.linear_map[c].ks;
       batch.col(F::kFric)[lane] = contacts.linear_params[c].fric;
@@ -1187,18 +1188,8 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
           }
           continue;
         }
-        // Another model (its history and flags in the columns): as run_rows.
-        const bool exists = contacts.exists[c];
-        if (!exists && !within_reach(ka, b, r.image)) continue;
-        if (!exists) {
-          if (hill.size() > 0) flush(hill);
-          if (linear.size() > 0) flush(linear);
-          add_share(c, force_row(c, dt));
-          continue;
-        }
-        if (hill.size() > 0) flush(hill);
-        if (linear.full()) flush(linear);
-        linear.add(static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b), r.image);
+        // Another model keeps its history and flags in the columns: this one row as run_rows takes it.
+        run_rows(k + 1, k, [rec](std::size_t j) -> std::size_t { return rec[j].row; }, true);
       }
     } else if (live && !full) {
       const std::uint32_t* rows = live_rows_.data();
