@@ -223,18 +223,20 @@ TEST(HillBatch, LiveRowsOrAllRowsGiveTheSameBits) {
 
 // The live rows through their records (use_live_records) or through the row columns: the same lanes
 // with the same inputs in the same order, so the same bits, dry and wet, with the row loop with and
-// without its contact branch. The run is cut into cycle() calls of 37 steps (the last step of each,
+// without its contact branch, and with the records' lanes filled and scattered eight at a time or
+// lane by lane (use_vector_fill, use_vector_scatter). The run is cut into cycle() calls of 37 steps (the last step of each,
 // looked at, goes through the columns), and make_wet between them reads and changes the columns, so
 // the records' history (n̂_c, F^h_s, M) must be back in the columns after every call: they are
 // compared bit for bit at the end.
 TEST(HillBatch, LiveRecordsOrColumnsGiveTheSameBits) {
   for (const auto& [branchless, proximity] : {std::pair{true, 0.0}, std::pair{false, 0.0}, std::pair{true, 1e-3}}) {
-    auto run = [branchless, proximity](bool records) {
+    auto run = [branchless, proximity](bool records, bool vectors = true) {
       Simulation sim = periodic_cloud();
       sim.settings.proximity = proximity;
       sim.use_branchless_rows = branchless;
       sim.branchless_rows_min = 0;
       sim.use_live_records = records;
+      sim.use_vector_fill = sim.use_vector_scatter = vectors;
       for (int k = 0; k < 8; ++k) sim.cycle(37);
       sim.make_wet(20e3, 0.5e-3);
       for (int k = 0; k < 4; ++k) sim.cycle(37);
@@ -243,11 +245,12 @@ TEST(HillBatch, LiveRecordsOrColumnsGiveTheSameBits) {
       for (int k = 0; k < 16; ++k) sim.cycle(37);
       return sim;
     };
-    const Simulation on = run(true), off = run(false);
+    const Simulation on = run(true), off = run(false), lane_by_lane = run(true, false);
     EXPECT_GT(on.live_record_passes(), 200);
     EXPECT_EQ(off.live_record_passes(), 0);
     const Outcome a = outcome(on), b = outcome(off);
     expect_same_bits(a, b);
+    expect_same_bits(outcome(lane_by_lane), b);  // (the records read and written lane by lane)
     EXPECT_GT(a.wet, 20u);
     EXPECT_EQ(a.wet, b.wet);
     EXPECT_EQ(a.ruptured, b.ruptured);

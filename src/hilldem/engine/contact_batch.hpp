@@ -94,6 +94,8 @@ class ContactBatch {
     add_if(true, row, ball1, ball2, image, slot);
   }
   std::uint32_t slot(std::size_t lane) const { return slot_[lane]; }
+  const std::uint32_t* slots() const { return slot_; }
+  const std::uint32_t* balls2() const { return ball2_; }
   std::uint8_t image(std::size_t lane) const { return image_[lane]; }
   std::uint32_t ball1(std::size_t lane) const { return ball1_[lane]; }
   std::uint32_t ball2(std::size_t lane) const { return ball2_[lane]; }

@@ -892,7 +892,39 @@ void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
     batch.col(F::kDamp)[lane] = p.damp_con;
     batch.col(F::kWet)[lane] = m == Moisture::Wet ? 1.0 : 0.0;
   };
-  for (lane = 0; lane < n; ++lane) {
+  lane = 0;
+#if defined(__AVX512F__)
+  if (hill && use_vector_fill) {
+    // Eight lanes with live records at a time: the records loaded whole and transposed in registers
+    // (n̂_c and F^h_s stored once for the eight lanes), the parameters gathered by set, M compared
+    // for the eight at once. The same values as put_hill's, so the same bits.
+    static_assert(sizeof(LiveRecord) == 64 && alignof(LiveRecord) == 64);
+    static_assert(offsetof(LiveRecord, hill_set) == 8 && offsetof(LiveRecord, moisture) == 15 &&
+                  offsetof(LiveRecord, normal) == 16 && offsetof(LiveRecord, shear) == 40);
+    static_assert(sizeof(HillParams) == 24 && offsetof(HillParams, fric_coef) == 0 &&
+                  offsetof(HillParams, damp_con) == 8 && offsetof(HillParams, suction) == 16);
+    const __m512i no_slot = _mm512_set1_epi64(ContactBatch::kNoSlot);
+    const double* sets = reinterpret_cast<const double*>(hill_sets_.data());
+    for (; lane + 8 <= n; lane += 8) {
+      const __m512i slots = _mm512_cvtepu32_epi64(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(batch.slots() + lane)));
+      if (_mm512_cmp_epi64_mask(slots, no_slot, _MM_CMPINT_NE) != 0xFF) break;  // (the rest lane by lane)
+      __m512d r[8], c[8];
+      for (std::size_t k = 0; k < 8; ++k) r[k] = _mm512_load_pd(reinterpret_cast<const double*>(&live_records_[batch.slot(lane + k)]));
+      transpose8(r, c);  // c[1]: set and flags; c[2..4]: n̂_c; c[5..7]: F^h_s
+      const F::Field history[6] = {F::kNox, F::kNoy, F::kNoz, F::kSx, F::kSy, F::kSz};
+      for (int f = 0; f < 6; ++f) _mm512_store_pd(batch.col(history[f]) + lane, c[2 + f]);
+      const __m512i flags = _mm512_castpd_si512(c[1]);
+      const __m512i at = _mm512_mullo_epi64(_mm512_and_si512(flags, _mm512_set1_epi64(0xFFFFFFFF)), _mm512_set1_epi64(3));
+      _mm512_store_pd(batch.col(F::kFric) + lane, _mm512_i64gather_pd(at, sets + 0, 8));
+      _mm512_store_pd(batch.col(F::kDamp) + lane, _mm512_i64gather_pd(at, sets + 1, 8));
+      _mm512_store_pd(batch.col(F::kSuction) + lane, _mm512_i64gather_pd(at, sets + 2, 8));
+      const __mmask8 wet = _mm512_cmp_epi64_mask(_mm512_srli_epi64(flags, 56),
+                                                 _mm512_set1_epi64(static_cast<int>(Moisture::Wet)), _MM_CMPINT_EQ);
+      _mm512_store_pd(batch.col(F::kWet) + lane, _mm512_maskz_mov_pd(wet, _mm512_set1_pd(1.0)));
+    }
+  }
+#endif
+  for (; lane < n; ++lane) {
     const std::size_t c = batch.row(lane);
     if (hill) {
       const std::uint32_t slot = batch.slot(lane);
@@ -990,7 +1022,8 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
     batched_count += static_cast<std::int64_t>(batch.size());
     batch_shares(batch, proximity);
     const double* quick = batch.col(F::kQuick);
-    for (std::size_t lane = 0; lane < batch.size(); ++lane) {
+    // One lane's results into its row (or live record) and its balls' sums, in lane order.
+    auto scatter_lane = [&](std::size_t lane) __attribute__((always_inline)) {
       const std::size_t c = batch.row(lane);
       const std::uint32_t slot = &batch == &hill ? batch.slot(lane) : ContactBatch::kNoSlot;
       if (quick[lane] == 0.0) {  // deleted, or a non-finite force: the general way
@@ -998,7 +1031,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
         store_row(c, lane_outcome(batch, lane, /*wall_row=*/false), want_stiffness, reported, share);
         add_share(c, share);
         if (slot != ContactBatch::kNoSlot) load_live_record(slot);  // (store_row wrote the columns)
-        continue;
+        return;
       }
       // The shares from the lanes; a live record's history into the record.
       if (slot != ContactBatch::kNoSlot) {
@@ -1015,7 +1048,58 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
         k_tran = batch.col(F::kKtran)[lane], k_shear = batch.col(F::kKshear)[lane], gap = batch.col(F::kGap)[lane];
       add_to_balls(batch.ball1(lane), batch.ball2(lane), batch.get3(F::kFx, lane), batch.get3(F::kMax, lane),
                    batch.get3(F::kMbx, lane), k_tran, k_shear, gap);
+    };
+    std::size_t lane = 0;
+#if defined(__AVX512F__)
+    // Eight hill lanes at a time when all eight take the common way with live records and nothing
+    // more is asked of them (kept, finite, no rupture, both balls in this thread's range, no reports,
+    // no stiffness): their shares transposed in registers into one 64-byte vector per ball, each
+    // ball's sums (one line, motion::ContactSums) added to in one operation, and n̂_c and F^h_s
+    // stored into each record at once. The same additions in the same lane order (x − F is x + (−F)
+    // bit for bit, and a fourth lane +0.0 stays +0.0), so the same bits as scatter_lane.
+    if (use_vector_scatter && records && &batch == &hill && !reported && !want_stiffness) {
+      const double* ruptured = batch.col(F::kRuptured);
+      const __m512d zero = _mm512_setzero_pd();
+      const __m512i no_slot = _mm512_set1_epi64(ContactBatch::kNoSlot);
+      const __m512i end = _mm512_set1_epi64(static_cast<long long>(range_end));
+      for (; lane + 8 <= batch.size(); lane += 8) {
+        const __mmask8 simple =
+            _mm512_cmp_pd_mask(_mm512_loadu_pd(quick + lane), zero, _CMP_NEQ_UQ) &
+            _mm512_cmp_pd_mask(_mm512_loadu_pd(ruptured + lane), zero, _CMP_EQ_OQ) &
+            _mm512_cmp_epi64_mask(_mm512_cvtepu32_epi64(_mm256_loadu_si256(
+                                      reinterpret_cast<const __m256i*>(batch.slots() + lane))),
+                                  no_slot, _MM_CMPINT_NE) &
+            _mm512_cmp_epi64_mask(_mm512_cvtepu32_epi64(_mm256_loadu_si256(
+                                      reinterpret_cast<const __m256i*>(batch.balls2() + lane))),
+                                  end, _MM_CMPINT_LT);
+        if (simple != 0xFF) {
+          for (std::size_t k = 0; k < 8; ++k) scatter_lane(lane + k);
+          continue;
+        }
+        auto col = [&](ContactBatch::Field f) { return _mm512_load_pd(batch.col(f) + lane); };
+        const __m512d fx = col(F::kFx), fy = col(F::kFy), fz = col(F::kFz);
+        __m512d c[8], share_a[8], share_b[8], history[8];
+        // Ball 1: [−F_c, +0.0, moment 1, +0.0]; ball 2: [F_c, +0.0, moment 2, +0.0].
+        c[0] = _mm512_sub_pd(zero, fx), c[1] = _mm512_sub_pd(zero, fy), c[2] = _mm512_sub_pd(zero, fz);
+        c[3] = zero, c[4] = col(F::kMax), c[5] = col(F::kMay), c[6] = col(F::kMaz), c[7] = zero;
+        transpose8(c, share_a);
+        c[0] = fx, c[1] = fy, c[2] = fz, c[4] = col(F::kMbx), c[5] = col(F::kMby), c[6] = col(F::kMbz);
+        transpose8(c, share_b);
+        // The record's doubles 2-7: n̂_c, then F^h_s (LiveRecord).
+        c[0] = zero, c[1] = zero, c[2] = col(F::kNx), c[3] = col(F::kNy), c[4] = col(F::kNz);
+        c[5] = col(F::kShx), c[6] = col(F::kShy), c[7] = col(F::kShz);
+        transpose8(c, history);
+        for (std::size_t k = 0; k < 8; ++k) {
+          double* a = reinterpret_cast<double*>(sums + batch.ball1(lane + k));
+          _mm512_store_pd(a, _mm512_add_pd(_mm512_load_pd(a), share_a[k]));
+          double* b = reinterpret_cast<double*>(sums + batch.ball2(lane + k));
+          _mm512_store_pd(b, _mm512_add_pd(_mm512_load_pd(b), share_b[k]));
+          _mm512_mask_store_pd(reinterpret_cast<double*>(&live_records_[batch.slot(lane + k)]), 0xFC, history[k]);
+        }
+      }
     }
+#endif
+    for (; lane < batch.size(); ++lane) scatter_lane(lane);
     batch.clear();
   };
   for (std::size_t a = a1; a-- > a0;) {

@@ -115,8 +115,13 @@ class Simulation {
   // row through the row-by-row laws (the two agree to rounding; kept for tests and comparison).
   bool use_batched_kernel = true;
   // The lanes' ball fields from whole ball records transposed in AVX-512 registers (where the build
-  // has AVX-512); false: copied lane by lane. The same bits either way (kept for tests).
+  // has AVX-512), and a hill lane's history, parameters and M from its live record likewise, eight
+  // lanes at a time; false: copied lane by lane. The same bits either way (kept for tests).
   bool use_vector_fill = true;
+  // The common lanes' results added into the balls' sums and written into the live records eight
+  // lanes at a time, transposed in AVX-512 registers (where the build has AVX-512); false: lane by
+  // lane. The same bits either way (kept for tests).
+  bool use_vector_scatter = true;
   // Hill rows (contacts and neighbour pairs alike) through the force pass's row loop without a branch
   // on whether the row is a contact (force_block), when there are more than branchless_rows_min rows;
   // false, or fewer rows: with that branch. The same bits either way. Below ≈ 15,000 rows the branch
