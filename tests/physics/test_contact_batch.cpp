@@ -202,8 +202,9 @@ TEST(HillBatch, RowsWithOrWithoutTheContactBranchGiveTheSameBits) {
 // The row loop over the live rows (use_live_rows) or over all rows: the pairs left out cannot come
 // within reach before the list is made again, the near pairs that do (new contacts) send their
 // ball through all its rows, so the same contacts are made at the same steps, summed in the same
-// order: the same bits, dry and wet, with the row loop with and without its contact branch. The fast
-// grains make the list be made again often (its slack grows), and make new contacts among the lanes.
+// order: the same bits, dry and wet, with the row loop with and without its contact branch, and with
+// the travel since the list bounded or measured every step. The fast grains make the list be made
+// again often (its slack grows), and make new contacts among the lanes.
 TEST(HillBatch, LiveRowsOrAllRowsGiveTheSameBits) {
   for (const bool branchless : {true, false}) {
     auto configure = [branchless](bool live) {
@@ -213,11 +214,20 @@ TEST(HillBatch, LiveRowsOrAllRowsGiveTheSameBits) {
         s.use_live_rows = live;
       };
     };
-    std::int64_t refreshes = 0;
+    std::int64_t refreshes = 0, refreshes_measured = 0;
     const Outcome live = periodic_wet_run([&](Simulation& s) { configure(true)(s); }, &refreshes);
     const Outcome all = periodic_wet_run(configure(false));
     expect_same_bits(live, all);
     EXPECT_GT(refreshes, 10);  // (made again on the way, not only at the neighbour-list rebuilds)
+    // The travel since the list measured ball by ball every step instead of bounded (use_live_bound).
+    const Outcome measured = periodic_wet_run(
+        [&](Simulation& s) {
+          configure(true)(s);
+          s.use_live_bound = false;
+        },
+        &refreshes_measured);
+    expect_same_bits(measured, all);
+    EXPECT_GT(refreshes_measured, 10);
   }
 }
 

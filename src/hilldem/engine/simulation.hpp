@@ -122,6 +122,11 @@ class Simulation {
   // lanes at a time, transposed in AVX-512 registers (where the build has AVX-512); false: lane by
   // lane. The same bits either way (kept for tests).
   bool use_vector_scatter = true;
+  // The record motion measures each ball's travel since the live rows were made only when a bound
+  // carried from step to step (the last measured travel plus each step's largest |V| Δt) comes near
+  // the slack; false: every step. Which steps make the live rows again may change, the results not
+  // (the live rows change no result).
+  bool use_live_bound = true;
   // Hill rows (contacts and neighbour pairs alike) through the force pass's row loop without a branch
   // on whether the row is a contact (force_block), when there are more than branchless_rows_min rows;
   // false, or fewer rows: with that branch. The same bits either way. Below ≈ 15,000 rows the branch
@@ -442,6 +447,12 @@ class Simulation {
   bool live_ready_ = false;
   bool live_now_ = false;          // this force pass visits the live rows
   double live_travel_ = 0.0;       // [m] the largest travel of a ball since the list (rebuild_if_needed)
+  // A bound on that travel [m] carried from step to step (valid while live_bound_valid_): exact where
+  // it was last measured ball by ball, then grown by each record motion by its largest |V| Δt
+  // (live_growth_, the last step's), as travel_bound_ is. advance_records measures ball by ball only
+  // when the bound, grown by a few more such steps, would pass the slack (use_live_bound).
+  double live_bound_ = 0.0, live_growth_ = 0.0;
+  bool live_bound_valid_ = false;
   bool live_travel_known_ = false; // measured for this pass
   void refresh_live_rows();
   // The live rows' records (use_live_records), in live-row order (live_rows_), one cache line each:
