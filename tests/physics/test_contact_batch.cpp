@@ -234,10 +234,10 @@ TEST(HillBatch, LiveRowsOrAllRowsGiveTheSameBits) {
 // The live rows through their records (use_live_records) or through the row columns: the same lanes
 // with the same inputs in the same order, so the same bits, dry and wet, with the row loop with and
 // without its contact branch, and with the records' lanes filled and scattered eight at a time or
-// lane by lane (use_vector_fill, use_vector_scatter). The run is cut into cycle() calls of 37 steps (the last step of each,
-// looked at, goes through the columns), and make_wet between them reads and changes the columns, so
-// the records' history (n̂_c, F^h_s, M) must be back in the columns after every call: they are
-// compared bit for bit at the end.
+// lane by lane (use_vector_fill, use_vector_scatter). The run is cut into cycle() calls of 37 steps
+// (the last step of each, looked at, goes through the columns), and make_wet between them reads and
+// changes the columns, so the records' history (n̂_c, F^h_s, M) must be back in the columns after
+// every call: they are compared bit for bit at the end.
 TEST(HillBatch, LiveRecordsOrColumnsGiveTheSameBits) {
   for (const auto& [branchless, proximity] : {std::pair{true, 0.0}, std::pair{false, 0.0}, std::pair{true, 1e-3}}) {
     auto run = [branchless, proximity](bool records, bool vectors = true) {
