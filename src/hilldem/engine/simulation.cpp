@@ -286,7 +286,7 @@ void Simulation::advance_records(double dt, const double* inertial_mass, const d
   const bool live_list = live_ready_ && position_at_live_.size() == n;
   // The travel since the live rows ball by ball (reading each ball's position then), or bounded
   // without it while the bound, grown by four steps like the last, stays within the slack.
-  const bool bounded = live_list && use_live_bound && live_bound_valid_ && live_bound_ + 4.0 * live_growth_ <= live_slack_;
+  const bool bounded = live_list && use_live_bound && live_bound_valid_ && live_travel_ + 4.0 * live_growth_ <= live_slack_;
   const bool live = live_list && !bounded;
   if (!applied_known_) {  // (once per cycle() call: nothing changes them until then)
     const auto zero = [](const std::vector<Vec3>& v) {
@@ -359,11 +359,10 @@ void Simulation::advance_records(double dt, const double* inertial_mass, const d
   const double growth = std::sqrt(max_v2) * dt * (1.0 + 1e-9) + 1e-15 * std::sqrt(max_x2);
   travel_bound_ += growth;
   motion_travel_known_ = true;
-  if (live) live_bound_ = std::sqrt(worst_live);  // (exact)
-  else if (bounded) live_bound_ += growth;
+  if (live) live_travel_ = std::sqrt(worst_live);  // (exact)
+  else if (bounded) live_travel_ += growth;
   live_growth_ = growth;
   live_bound_valid_ = live_list;
-  live_travel_ = live_bound_;
   live_travel_known_ = live_list;
 }
 
@@ -422,7 +421,6 @@ void Simulation::rebuild_if_needed() {
     }
     live_travel_ = std::sqrt(worst_live);
     live_travel_known_ = live;
-    live_bound_ = live_travel_;
     live_bound_valid_ = live;
     const double ball_travel = std::sqrt(worst);
     travel_bound_ = ball_travel;  // (exact now: the record motion grows it from here)
@@ -782,6 +780,10 @@ HILLDEM_INLINE bool pair_within_reach(const Kin& ka, const Kin& kb, ImageCode im
 namespace {
 // The 8 x 8 transpose of doubles: r[i] holds lane i's eight fields, c[j] field j of the eight lanes
 // (unpack pairs of lanes, then pairs of pairs, then the two halves).
+// Eight 32-bit lane indices (a batch's slots or balls) from p, as eight 64-bit lanes.
+HILLDEM_INLINE __m512i widen8(const std::uint32_t* p) {
+  return _mm512_cvtepu32_epi64(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)));
+}
 HILLDEM_INLINE void transpose8(const __m512d r[8], __m512d c[8]) {
   __m512d t[8], u[8];
   for (int k = 0; k < 4; ++k) {
@@ -891,8 +893,9 @@ void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
       batch.col(F::kCs)[lane] = ka.terms.shear + kb.terms.shear;
     }
   }
-  // The rows' own inputs, lane by lane. (Eight rows' Vec3s loaded whole and transposed as well, and
-  // the parameters set for eight lanes at once: 1.000 x in cache, 16 pairs; not kept.)
+  // The rows' own inputs. (From the row columns, eight rows' Vec3s loaded whole and transposed, and
+  // the parameters set for eight lanes at once, gave 1.000 x in cache, 16 pairs: not kept. From the
+  // live records, one aligned line a row, it pays: below.)
   // A hill lane's history, parameter set and M: from its live record (use_live_records), or from
   // the row columns.
   auto put_hill = [&](std::size_t lane, const Vec3& normal, const Vec3& shear, std::uint32_t set, Moisture m) {
@@ -917,8 +920,7 @@ void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
     const __m512i no_slot = _mm512_set1_epi64(ContactBatch::kNoSlot);
     const double* sets = reinterpret_cast<const double*>(hill_sets_.data());
     for (; lane + 8 <= n; lane += 8) {
-      const __m512i slots = _mm512_cvtepu32_epi64(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(batch.slots() + lane)));
-      if (_mm512_cmp_epi64_mask(slots, no_slot, _MM_CMPINT_NE) != 0xFF) break;  // (the rest lane by lane)
+      if (_mm512_cmp_epi64_mask(widen8(batch.slots() + lane), no_slot, _MM_CMPINT_NE) != 0xFF) break;  // (the rest lane by lane)
       __m512d r[8], c[8];
       for (std::size_t k = 0; k < 8; ++k) r[k] = _mm512_load_pd(reinterpret_cast<const double*>(&live_records_[batch.slot(lane + k)]));
       transpose8(r, c);  // c[1]: set and flags; c[2..4]: n̂_c; c[5..7]: F^h_s
@@ -1077,12 +1079,8 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
         const __mmask8 simple =
             _mm512_cmp_pd_mask(_mm512_loadu_pd(quick + lane), zero, _CMP_NEQ_UQ) &
             _mm512_cmp_pd_mask(_mm512_loadu_pd(ruptured + lane), zero, _CMP_EQ_OQ) &
-            _mm512_cmp_epi64_mask(_mm512_cvtepu32_epi64(_mm256_loadu_si256(
-                                      reinterpret_cast<const __m256i*>(batch.slots() + lane))),
-                                  no_slot, _MM_CMPINT_NE) &
-            _mm512_cmp_epi64_mask(_mm512_cvtepu32_epi64(_mm256_loadu_si256(
-                                      reinterpret_cast<const __m256i*>(batch.balls2() + lane))),
-                                  end, _MM_CMPINT_LT);
+            _mm512_cmp_epi64_mask(widen8(batch.slots() + lane), no_slot, _MM_CMPINT_NE) &
+            _mm512_cmp_epi64_mask(widen8(batch.balls2() + lane), end, _MM_CMPINT_LT);
         if (simple != 0xFF) {
           for (std::size_t k = 0; k < 8; ++k) scatter_lane(lane + k);
           continue;
@@ -1515,7 +1513,7 @@ void Simulation::refresh_live_rows() {
   }
   position_at_live_.resize(n);
   for (std::size_t i = 0; i < n; ++i) position_at_live_[i] = ball_kin_[i].position;
-  live_bound_ = 0.0;
+  live_travel_ = 0.0;
   live_bound_valid_ = true;
   live_proximity_ = settings.proximity;
   live_rows_of_ = contacts.size();

@@ -446,12 +446,12 @@ class Simulation {
   std::int64_t live_refreshes_ = 0;
   bool live_ready_ = false;
   bool live_now_ = false;          // this force pass visits the live rows
-  double live_travel_ = 0.0;       // [m] the largest travel of a ball since the list (rebuild_if_needed)
-  // A bound on that travel [m] carried from step to step (valid while live_bound_valid_): exact where
-  // it was last measured ball by ball, then grown by each record motion by its largest |V| Δt
-  // (live_growth_, the last step's), as travel_bound_ is. advance_records measures ball by ball only
-  // when the bound, grown by a few more such steps, would pass the slack (use_live_bound).
-  double live_bound_ = 0.0, live_growth_ = 0.0;
+  // [m] the largest travel of a ball since the list, or a bound on it carried from step to step
+  // (valid while live_bound_valid_): exact where it was last measured ball by ball (rebuild_if_needed,
+  // advance_records), then grown by each record motion by its largest |V| Δt (live_growth_, the last
+  // step's), as travel_bound_ is. advance_records measures ball by ball only when the bound, grown by
+  // a few more such steps, would pass the slack (use_live_bound).
+  double live_travel_ = 0.0, live_growth_ = 0.0;
   bool live_bound_valid_ = false;
   bool live_travel_known_ = false; // measured for this pass
   void refresh_live_rows();
