@@ -399,8 +399,10 @@ class Simulation {
   bool applied_known_ = false, applied_zero_ = false;
   bool skin_known_ = false;
   double skin_ = 0.0;  // [m] skin() while skin_known_
-  // Per ball, its rows that were contacts in the last pass with more than one thread (split_work).
+  // Per ball, its rows that were contacts in the last pass with more than one thread and without
+  // the live rows (split_work).
   std::vector<std::uint32_t> ball_contacts_;
+  bool split_by_live_rows() const;  // split_work weighs the balls by their live and near rows
   std::vector<std::size_t> work_start_;        // threads' ranges of balls in the force pass (split_work)
   std::vector<std::uint64_t> work_prefix_;     // split_work's running sum of work per ball
   std::size_t split_rows_ = 0;                 // rows when the split was made
