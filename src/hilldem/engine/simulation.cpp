@@ -1426,8 +1426,8 @@ void Simulation::split_work(int threads) {
   // ball itself (its record, its half of the force sum). With the live rows (split_by_live_rows):
   // one for each near row (the near check) and four for each live row (gather, law and scatter);
   // the lists hold these counts already. Otherwise: each of its rows, and three more for each that
-  // was a contact in the last pass (ball_contacts_, counted by that pass: a read of every row's
-  // flag, 1.07-1.10 x of a two-thread step at 100,800 spheres when it was made every pass).
+  // was a contact in the last pass (ball_contacts_, counted by that pass from every row's flag: a
+  // read that, on every two-thread pass, cost 1.07-1.10 x at 100,800 spheres).
   // Threads get ranges of equal work, not of equal numbers of balls: rows and contacts per ball vary
   // across a specimen (denser at the bottom of a bed, none above its surface), and with equal
   // numbers of balls one thread waited at the end of the pass (a third of its time on an unsettled
