@@ -3,6 +3,7 @@
 // bits; and the columns hold the balls' state whenever anyone outside the cycle can look: after
 // every cycle() call, in every observer and controller, after a run that threw.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <cmath>
 #include <cstring>
@@ -216,6 +217,43 @@ TEST(Motion, ForceColumnsAreTheRowsSumsWheneverSomeoneLooks) {
     sim.observers.push_back([&worst](const Simulation& s) { worst = std::max(worst, worst_force_sum_error(s)); });
     sim.cycle(20);
     EXPECT_LT(worst, 1e-12) << records;
+  }
+}
+
+// Each thread ends its own balls' force sums (Simulation::use_owner_sums): the crossing shares from
+// the ranges below, as soon as each is final, then its balls' floor rows. One, two and three threads,
+// with and without: the same bits in the balls, and in the floor's sums after each call.
+TEST(Motion, OwnerSumsGiveTheSameBits) {
+  const Packing bed = read_packing(HILLDEM_SOURCE_DIR "/bench/bed_settled.data", PackingFormat::Lammps);
+  struct Run {
+    State state;
+    std::vector<Wall> floor;
+  };
+  auto run = [&bed](int threads, bool owner) {
+    omp_set_num_threads(threads);
+    Simulation sim = make_bed(bed);
+    sim.settings.local_damping = 0.0;  // (the balls keep moving)
+    sim.use_owner_sums = owner;
+    std::vector<Wall> floor;
+    for (int k = 0; k < 3; ++k) {
+      sim.cycle(40);
+      floor.push_back(sim.walls.walls[0]);
+    }
+    omp_set_num_threads(omp_get_num_procs());
+    return Run{state(sim), floor};
+  };
+  const Run one = run(1, false);
+  EXPECT_GT(one.floor[2].active_contacts, 100u);
+  for (const auto& [threads, owner] : {std::pair{1, true}, std::pair{2, true}, std::pair{3, true}, std::pair{2, false}}) {
+    const Run other = run(threads, owner);
+    expect_same(one.state, other.state);
+    for (std::size_t k = 0; k < one.floor.size(); ++k) {
+      const Wall &a = one.floor[k], &b = other.floor[k];
+      EXPECT_TRUE(same_bits(a.force, b.force) && same_bits(a.moment, b.moment)) << threads << owner << k;
+      EXPECT_EQ(std::memcmp(&a.normal_force, &b.normal_force, sizeof(double)), 0) << threads << owner << k;
+      EXPECT_EQ(std::memcmp(&a.normal_stiffness, &b.normal_stiffness, sizeof(double)), 0) << threads << owner << k;
+      EXPECT_EQ(a.active_contacts, b.active_contacts) << threads << owner << k;
+    }
   }
 }
 

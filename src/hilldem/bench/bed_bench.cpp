@@ -86,7 +86,7 @@ std::int64_t settle_bed(const std::string& in, const std::string& out, double ra
 
 const std::vector<std::string>& alternate_switches() {
   static const std::vector<std::string> names{"vector-fill", "branchless-rows", "live-rows", "speed-split",
-                                               "record-motion", "live-records", "vector-scatter", "live-bound"};
+                                               "record-motion", "live-records", "vector-scatter", "live-bound", "owner-sums"};
   return names;
 }
 
@@ -103,6 +103,7 @@ bool& switch_of(Simulation& sim, const std::string& name) {
   if (name == "live-records") return sim.use_live_records;
   if (name == "vector-scatter") return sim.use_vector_scatter;
   if (name == "live-bound") return sim.use_live_bound;
+  if (name == "owner-sums") return sim.use_owner_sums;
   std::string allowed;
   for (const std::string& s : alternate_switches()) allowed += (allowed.empty() ? "" : ", ") + s;
   throw InputError("bench --alternate: unknown switch '" + name + "' (allowed: " + allowed + ")");

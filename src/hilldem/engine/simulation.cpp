@@ -13,6 +13,7 @@
 #include <memory>
 #include <numeric>
 #include <sstream>
+#include <thread>
 #include <type_traits>
 
 #if defined(__AVX512F__)
@@ -510,6 +511,7 @@ void Simulation::build_row_lists() {
   const std::size_t rows = contacts.size();
   if (rows > static_cast<std::size_t>(std::numeric_limits<std::uint32_t>::max()))
     throw RunError("too many neighbour pairs (" + std::to_string(rows) + ") for one process");
+  crossing_floor_.clear();  // (made again from these rows: force_pass)
   first_rows_.assign(n + 1, 0);
   late_rows_start_.assign(n + 1, 0);
   wall_rows_start_.assign(n + 1, 0);
@@ -1427,7 +1429,8 @@ void Simulation::split_work(int threads) {
   // one for each near row (the near check) and four for each live row (gather, law and scatter);
   // the lists hold these counts already. Otherwise: each of its rows, and three more for each that
   // was a contact in the last pass (ball_contacts_, counted by that pass from every row's flag: a
-  // read that, on every two-thread pass, cost 1.07-1.10 x at 100,800 spheres).
+  // read that, on every two-thread pass, cost 1.07-1.10 x at 100,800 spheres). And four for each of
+  // its wall rows, which its thread runs (use_owner_sums).
   // Threads get ranges of equal work, not of equal numbers of balls: rows and contacts per ball vary
   // across a specimen (denser at the bottom of a bed, none above its surface), and with equal
   // numbers of balls one thread waited at the end of the pass (a third of its time on an unsettled
@@ -1441,11 +1444,13 @@ void Simulation::split_work(int threads) {
   prefix[0] = 0;
   if (split_by_live_rows()) {
     for (std::size_t i = 0; i < n; ++i)
-      prefix[i + 1] = prefix[i] + 2 + (near_first_[i + 1] - near_first_[i]) + 4 * (live_first_[i + 1] - live_first_[i]);
+      prefix[i + 1] = prefix[i] + 2 + (near_first_[i + 1] - near_first_[i]) + 4 * (live_first_[i + 1] - live_first_[i]) +
+                      4 * (wall_rows_start_[i + 1] - wall_rows_start_[i]);
   } else {
     const bool have_counts = ball_contacts_.size() == n;
     for (std::size_t i = 0; i < n; ++i)
-      prefix[i + 1] = prefix[i] + 2 + (first_rows_[i + 1] - first_rows_[i]) + (have_counts ? 3 * ball_contacts_[i] : 0);
+      prefix[i + 1] = prefix[i] + 2 + (first_rows_[i + 1] - first_rows_[i]) + (have_counts ? 3 * ball_contacts_[i] : 0) +
+                      4 * (wall_rows_start_[i + 1] - wall_rows_start_[i]);
   }
   // Thread t's share of the work: given (thread_shares), equal, or in proportion to the threads'
   // speeds (balance_speeds).
@@ -1624,7 +1629,6 @@ void Simulation::force_pass(double dt) {
     }
     records_current_ = true;
   }
-  const std::size_t wall_rows = wall_rows_.size();
   ball_contacts_.resize(n);
   // The live rows (use_live_rows), made again when a ball may have moved more than the slack since
   // they were (rebuild_if_needed measured it), or the rows, their models or the proximity may have
@@ -1646,6 +1650,10 @@ void Simulation::force_pass(double dt) {
   live_record_passes_ += live_records_ready_;
   std::size_t full_balls = 0;  // balls that visited all their rows (force_block)
   const bool live_split = split_by_live_rows();
+  std::unique_ptr<std::atomic<bool>[]> crossing_done;  // per thread: its crossing list is final
+  const bool owner = use_owner_sums;
+  owner_sums_pass_ = owner;
+  std::atomic<bool> late_share{false};
 #pragma omp parallel reduction(min : bad_row) reduction(+ : batched, full_balls) if (n > kParallelMin)
   {
     // ≈ 60 kB: on the heap, not the thread's stack. Default-initialised: make_unique would zero it on
@@ -1674,6 +1682,9 @@ void Simulation::force_pass(double dt) {
         speed_age_ = 0;
       }
       crossing_.resize(threads);
+      if (resplit || crossing_floor_.size() != threads) crossing_floor_.assign(threads, kFloorUnknown);
+      crossing_done.reset(new std::atomic<bool>[threads]);
+      for (std::size_t u = 0; u < threads; ++u) crossing_done[u].store(false, std::memory_order_relaxed);
     }
     const auto t = static_cast<std::size_t>(omp_get_thread_num());
     const std::size_t first = work_start_[t], last = work_start_[t + 1];
@@ -1684,23 +1695,72 @@ void Simulation::force_pass(double dt) {
     const bool timed = omp_get_num_threads() > 1;
     const bool count_contacts = timed && !live_split;
     const double busy_from = timed ? omp_get_wtime() : 0.0;
+    // The lowest ball of the range with a row into a later range (made once per split: the rows do
+    // not change until the next). Below it the thread adds no crossing share, and from there its list
+    // is final and announced (crossing_done), long before its pass ends: the blocks run from the
+    // last down, and the crossing rows are those of its top layer of balls.
+    if (crossing_floor_[t] == kFloorUnknown) {
+      std::size_t floor = last;
+      for (std::size_t a = first; a < last && floor == last; ++a)
+        if (first_rows_[a + 1] > first_rows_[a] && contacts.key[first_rows_[a + 1] - 1].b >= last) floor = a;
+      crossing_floor_[t] = floor;
+    }
+    const std::size_t floor = crossing_floor_[t];
+    bool announced = false;
+    std::size_t announced_size = 0;
+    auto announce = [&] {
+      crossing_done[t].store(true, std::memory_order_release);
+      announced = true;
+      announced_size = crossing.size();
+    };
+    if (owner && floor >= last) announce();
     if (last > first)
       for (std::size_t a = first + (last - first - 1) / block * block;; a -= block) {
         force_block(a, std::min(last, a + block), last, dt, *scratch, crossing, bad_row, batched, count_contacts,
                     full_balls);
+        if (owner && !announced && a <= floor) announce();
         if (a == first) break;
       }
-    if (timed) thread_busy_[t] += omp_get_wtime() - busy_from;  // [s] (balance_speeds)
-    // The wall rows, shared out among the threads whatever their number (no thread waits for
-    // another to do them alone), each thread's part in batches (wall_block). Each row's result
-    // depends on no other row, nor on the batch it falls into (the lanes are padded), so the split
-    // changes no bit.
-    {
+    if (owner && !announced) announce();
+    // (A share added after the list was announced would be a wrong floor: another thread may have read
+    // the list already. Never seen; checked, as it costs nothing.)
+    if (owner && crossing.size() != announced_size) late_share.store(true, std::memory_order_relaxed);
+    // The end of the range's force sums, by the thread itself, in their order (force_pass): the
+    // crossing shares into its balls from the ranges below, the last range's first (each list once
+    // its thread announced it: no wait in practice), then its balls' wall rows in row order
+    // (wall_block: each row's result depends on no other row, nor on the batch it falls into).
+    const bool want_stiffness = settings.auto_timestep || settings.density_scaling;
+    motion::ContactSums* __restrict sums = ball_sums_.data();
+    for (std::size_t u = owner ? t : 0; u-- > 0;) {
+      for (int spin = 0; !crossing_done[u].load(std::memory_order_acquire); ++spin)
+        if (spin > 1000) std::this_thread::yield();  // (more threads than cores: let the other run)
+      for (const CrossShare& c : crossing_[u])
+        if (c.b >= first && c.b < last) {
+          sums[c.b].force += motion::load(c.force);
+          sums[c.b].moment += motion::load(c.moment);
+          if (want_stiffness)
+            add_stiffness(c.k_tran, c.k_shear, balls.radius[c.b], c.gap, ball_k_tran_[c.b], ball_k_rot_[c.b]);
+        }
+    }
+    if (!owner) {
       const auto threads = static_cast<std::size_t>(omp_get_num_threads());
-      const std::size_t k0 = wall_rows * t / threads, k1 = wall_rows * (t + 1) / threads;
+      const std::size_t k0 = wall_rows_.size() * t / threads, k1 = wall_rows_.size() * (t + 1) / threads;
       if (k1 > k0) wall_block(k0, k1, dt, *scratch, bad_row, batched);
     }
+    const std::size_t k0 = wall_rows_start_[first], k1 = wall_rows_start_[last];
+    if (owner && k1 > k0) {
+      wall_block(k0, k1, dt, *scratch, bad_row, batched);
+      for (std::size_t k = k0; k < k1; ++k) {
+        const std::uint32_t c = wall_rows_[k];
+        const std::size_t a = contacts.key[c].a;
+        sums[a].force -= motion::load(contacts.force[c]);
+        sums[a].moment += motion::load(share_moment_[c]);
+        if (want_stiffness) add_row_stiffness(c, balls.radius[a], ball_k_tran_[a], ball_k_rot_[a]);
+      }
+    }
+    if (timed) thread_busy_[t] += omp_get_wtime() - busy_from;  // [s] (balance_speeds)
   }
+  if (late_share.load()) throw RunError("internal error: a crossing share after its list was final (force_pass)");
   batched_rows_ = batched;
   body_terms_ready_ = true;
   // Many balls visiting all their rows (their new contacts are not live rows): the list is made
@@ -1720,30 +1780,36 @@ void Simulation::force_pass(double dt) {
 }
 
 void Simulation::collect_forces() {
-  // The end of every ball's force sum (the order of force_pass): the shares of rows whose second
-  // ball lay beyond the range of the thread that ran them, in descending row order (the threads'
-  // ranges from the last down, each thread's list in the order it was made), then each ball's wall
-  // rows in row order. Rows that are not active contacts hold zero force and moment.
+  // Unless the threads did it themselves (use_owner_sums), the end of every ball's force sum (the
+  // order of force_pass): the shares of rows whose second ball lay beyond the range of the thread
+  // that ran them, in descending row order (the threads' ranges from the last down, each thread's
+  // list in the order it was made), then each ball's wall rows in row order. Then the walls' sums.
+  // Rows that are not active contacts hold zero force and moment.
   const bool want_stiffness = settings.auto_timestep || settings.density_scaling;
-  motion::ContactSums* __restrict sums = ball_sums_.data();
-  for (std::size_t t = crossing_.size(); t-- > 0;)
-    for (const CrossShare& s : crossing_[t]) {
-      sums[s.b].force += motion::load(s.force);
-      sums[s.b].moment += motion::load(s.moment);
-      if (want_stiffness)
-        add_stiffness(s.k_tran, s.k_shear, balls.radius[s.b], s.gap, ball_k_tran_[s.b], ball_k_rot_[s.b]);
+  if (!owner_sums_pass_) {
+    motion::ContactSums* __restrict sums = ball_sums_.data();
+    for (std::size_t t = crossing_.size(); t-- > 0;)
+      for (const CrossShare& s : crossing_[t]) {
+        sums[s.b].force += motion::load(s.force);
+        sums[s.b].moment += motion::load(s.moment);
+        if (want_stiffness)
+          add_stiffness(s.k_tran, s.k_shear, balls.radius[s.b], s.gap, ball_k_tran_[s.b], ball_k_rot_[s.b]);
+      }
+    for (std::uint32_t c : wall_rows_) {
+      const ContactKey& k = contacts.key[c];
+      sums[k.a].force -= motion::load(contacts.force[c]);
+      sums[k.a].moment += motion::load(share_moment_[c]);
+      if (want_stiffness) add_row_stiffness(c, balls.radius[k.a], ball_k_tran_[k.a], ball_k_rot_[k.a]);
     }
+  }
   for (Wall& w : walls.walls) {
     w.force = w.moment = Vec3{};
     w.normal_force = w.normal_stiffness = 0.0;
     w.active_contacts = 0;
   }
-  // Each wall row: the end of its ball's sums, and the wall's sums (both in row order).
+  // Each wall row into its wall's sums, in row order.
   for (std::uint32_t c : wall_rows_) {
     const ContactKey& k = contacts.key[c];
-    sums[k.a].force -= motion::load(contacts.force[c]);
-    sums[k.a].moment += motion::load(share_moment_[c]);
-    if (want_stiffness) add_row_stiffness(c, balls.radius[k.a], ball_k_tran_[k.a], ball_k_rot_[k.a]);
     if (!contacts.active[c]) continue;
     Wall& w = walls.walls[k.b];
     const Vec3 point = ball_kin_[k.a].position + contacts.normal[c] * (balls.radius[k.a] + 0.5 * contacts.gap[c]);

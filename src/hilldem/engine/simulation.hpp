@@ -159,6 +159,14 @@ class Simulation {
   // Threads share the balls of the force pass in proportion to their measured speeds (the cores of a
   // shared machine do not run equally fast); false: equal work. Results do not depend on the shares.
   bool use_speed_split = true;
+  // Each thread of the force pass ends its own balls' force sums. It adds the shares from rows that
+  // crossed into them from the ranges below. Each range's list is added as soon as its thread has
+  // passed its top layer of balls, which is early, since the blocks run from the top down. Then it
+  // runs its balls' wall rows and adds them.
+  // false: one thread adds all of it after the pass while the others wait, and the wall rows are
+  // shared out by count. The same bits either way. Median 1.02 x on two threads at 100,800 spheres
+  // (twelve --alternate runs, 0.96-1.04 x; docs/performance.md, twentieth session).
+  bool use_owner_sums = true;
   // Within a cycle() call, on the steps nobody looks at, the row loop reads and writes each live row
   // through a record of one cache line in live-row order (its second ball, image, flags, parameter
   // set, n̂_c and F^h_s), and each near row through a small record of its own, instead of through the
@@ -317,7 +325,8 @@ class Simulation {
   // columns and share_moment_; collect_forces() sums them in row order, so the batches need no order.
   void wall_block(std::size_t k0, std::size_t k1, double dt, BlockScratch& scratch, std::size_t& bad_row,
                   std::int64_t& batched);
-  // The end of the force sum: the crossing shares, then each ball's wall rows; the walls' sums.
+  // The walls' sums; and, after a pass without use_owner_sums, the end of the balls' force sums (the
+  // crossing shares, then each ball's wall rows).
   void collect_forces();
   void compute_mapping(ContactStore& store, std::size_t c) const;
   // Row c becomes a contact (created by proximity) with its rule's properties.
@@ -345,8 +354,9 @@ class Simulation {
   // (rows first_rows_[a]..[a+1]: keys are sorted by kind, then a, then b > a) from the last down,
   // and adds each row's share to a and to b: b's own rows came before (b > a), and every row (x, b)
   // with x < a comes after. A row whose b lies beyond the thread's range leaves b's share in
-  // crossing_, added after the pass in descending row order: those rows (x below the range of b's
-  // thread) come last in b's order. Then the wall rows, from F_c and share_moment_.
+  // crossing_, added in descending row order once the thread's own rows are done (by b's thread,
+  // use_owner_sums; or after the pass): those rows (x below the range of b's thread) come last in b's
+  // order. Then the wall rows, from F_c and share_moment_.
   std::vector<std::uint32_t> first_rows_;
   // Per ball, the ball-ball rows where it is piece 2 (in row order; the same sums from the rows
   // when the pass's sums are not at hand, ball_stiffness), and its wall rows in wall_rows_.
@@ -355,6 +365,11 @@ class Simulation {
   std::vector<std::uint32_t> wall_rows_start_;
   std::vector<Vec3> share_moment_;           // [N m] moment of wall row r on its ball
   std::vector<std::vector<CrossShare>> crossing_;  // per thread of the last force pass
+  // Per range of the split, its lowest ball with a ball-ball row into a later range: below it the
+  // range's thread adds no crossing share (force_pass). Made once per split and row lists.
+  std::vector<std::size_t> crossing_floor_;
+  bool owner_sums_pass_ = true;  // the last force pass ran with use_owner_sums (collect_forces)
+  static constexpr std::size_t kFloorUnknown = ~std::size_t{0};
   // Per ball, Σ(k̂_n + k̂_s) [N/m] and Σ k̂_s |x_c − x|² [N m] of the last force pass (in the order of
   // the forces), valid while stiffness_ready_.
   std::vector<double> ball_k_tran_, ball_k_rot_;
