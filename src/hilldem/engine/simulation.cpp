@@ -1442,15 +1442,12 @@ void Simulation::split_work(int threads) {
   std::vector<std::uint64_t>& prefix = work_prefix_;
   prefix.resize(n + 1);
   prefix[0] = 0;
-  if (split_by_live_rows()) {
-    for (std::size_t i = 0; i < n; ++i)
-      prefix[i + 1] = prefix[i] + 2 + (near_first_[i + 1] - near_first_[i]) + 4 * (live_first_[i + 1] - live_first_[i]) +
-                      4 * (wall_rows_start_[i + 1] - wall_rows_start_[i]);
-  } else {
-    const bool have_counts = ball_contacts_.size() == n;
-    for (std::size_t i = 0; i < n; ++i)
-      prefix[i + 1] = prefix[i] + 2 + (first_rows_[i + 1] - first_rows_[i]) + (have_counts ? 3 * ball_contacts_[i] : 0) +
-                      4 * (wall_rows_start_[i + 1] - wall_rows_start_[i]);
+  const bool live = split_by_live_rows();
+  const bool have_counts = ball_contacts_.size() == n;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint64_t rows = live ? (near_first_[i + 1] - near_first_[i]) + 4 * (live_first_[i + 1] - live_first_[i])
+                                    : (first_rows_[i + 1] - first_rows_[i]) + (have_counts ? 3 * ball_contacts_[i] : 0);
+    prefix[i + 1] = prefix[i] + 2 + rows + 4 * (wall_rows_start_[i + 1] - wall_rows_start_[i]);
   }
   // Thread t's share of the work: given (thread_shares), equal, or in proportion to the threads'
   // speeds (balance_speeds).
@@ -1652,7 +1649,6 @@ void Simulation::force_pass(double dt) {
   const bool live_split = split_by_live_rows();
   std::unique_ptr<std::atomic<bool>[]> crossing_done;  // per thread: its crossing list is final
   const bool owner = use_owner_sums;
-  owner_sums_pass_ = owner;
   std::atomic<bool> late_share{false};
 #pragma omp parallel reduction(min : bad_row) reduction(+ : batched, full_balls) if (n > kParallelMin)
   {
@@ -1699,7 +1695,7 @@ void Simulation::force_pass(double dt) {
     // not change until the next). Below it the thread adds no crossing share, and from there its list
     // is final and announced (crossing_done), long before its pass ends: the blocks run from the
     // last down, and the crossing rows are those of its top layer of balls.
-    if (crossing_floor_[t] == kFloorUnknown) {
+    if (owner && crossing_floor_[t] == kFloorUnknown) {
       std::size_t floor = last;
       for (std::size_t a = first; a < last && floor == last; ++a)
         if (first_rows_[a + 1] > first_rows_[a] && contacts.key[first_rows_[a + 1] - 1].b >= last) floor = a;
@@ -1729,34 +1725,21 @@ void Simulation::force_pass(double dt) {
     // crossing shares into its balls from the ranges below, the last range's first (each list once
     // its thread announced it: no wait in practice), then its balls' wall rows in row order
     // (wall_block: each row's result depends on no other row, nor on the batch it falls into).
-    const bool want_stiffness = settings.auto_timestep || settings.density_scaling;
-    motion::ContactSums* __restrict sums = ball_sums_.data();
-    for (std::size_t u = owner ? t : 0; u-- > 0;) {
-      for (int spin = 0; !crossing_done[u].load(std::memory_order_acquire); ++spin)
-        if (spin > 1000) std::this_thread::yield();  // (more threads than cores: let the other run)
-      for (const CrossShare& c : crossing_[u])
-        if (c.b >= first && c.b < last) {
-          sums[c.b].force += motion::load(c.force);
-          sums[c.b].moment += motion::load(c.moment);
-          if (want_stiffness)
-            add_stiffness(c.k_tran, c.k_shear, balls.radius[c.b], c.gap, ball_k_tran_[c.b], ball_k_rot_[c.b]);
-        }
-    }
-    if (!owner) {
+    if (owner) {
+      for (std::size_t u = t; u-- > 0;) {
+        for (int spin = 0; !crossing_done[u].load(std::memory_order_acquire); ++spin)
+          if (spin > 1000) std::this_thread::yield();  // (more threads than cores: let the other run)
+        add_crossing(crossing_[u], first, last);
+      }
+      const std::size_t k0 = wall_rows_start_[first], k1 = wall_rows_start_[last];
+      if (k1 > k0) {
+        wall_block(k0, k1, dt, *scratch, bad_row, batched);
+        add_wall_rows(k0, k1);
+      }
+    } else {
       const auto threads = static_cast<std::size_t>(omp_get_num_threads());
       const std::size_t k0 = wall_rows_.size() * t / threads, k1 = wall_rows_.size() * (t + 1) / threads;
       if (k1 > k0) wall_block(k0, k1, dt, *scratch, bad_row, batched);
-    }
-    const std::size_t k0 = wall_rows_start_[first], k1 = wall_rows_start_[last];
-    if (owner && k1 > k0) {
-      wall_block(k0, k1, dt, *scratch, bad_row, batched);
-      for (std::size_t k = k0; k < k1; ++k) {
-        const std::uint32_t c = wall_rows_[k];
-        const std::size_t a = contacts.key[c].a;
-        sums[a].force -= motion::load(contacts.force[c]);
-        sums[a].moment += motion::load(share_moment_[c]);
-        if (want_stiffness) add_row_stiffness(c, balls.radius[a], ball_k_tran_[a], ball_k_rot_[a]);
-      }
     }
     if (timed) thread_busy_[t] += omp_get_wtime() - busy_from;  // [s] (balance_speeds)
   }
@@ -1776,31 +1759,43 @@ void Simulation::force_pass(double dt) {
         << " (gap " << contacts.gap[bad_row] << " m): the run is unstable; reduce the time step";
     throw RunError(msg.str());
   }
-  collect_forces();
+  collect_forces(/*ball_ends_added=*/owner);
 }
 
-void Simulation::collect_forces() {
-  // Unless the threads did it themselves (use_owner_sums), the end of every ball's force sum (the
-  // order of force_pass): the shares of rows whose second ball lay beyond the range of the thread
-  // that ran them, in descending row order (the threads' ranges from the last down, each thread's
-  // list in the order it was made), then each ball's wall rows in row order. Then the walls' sums.
-  // Rows that are not active contacts hold zero force and moment.
+void Simulation::add_crossing(const std::vector<CrossShare>& list, std::size_t first, std::size_t last) {
   const bool want_stiffness = settings.auto_timestep || settings.density_scaling;
-  if (!owner_sums_pass_) {
-    motion::ContactSums* __restrict sums = ball_sums_.data();
-    for (std::size_t t = crossing_.size(); t-- > 0;)
-      for (const CrossShare& s : crossing_[t]) {
-        sums[s.b].force += motion::load(s.force);
-        sums[s.b].moment += motion::load(s.moment);
-        if (want_stiffness)
-          add_stiffness(s.k_tran, s.k_shear, balls.radius[s.b], s.gap, ball_k_tran_[s.b], ball_k_rot_[s.b]);
-      }
-    for (std::uint32_t c : wall_rows_) {
-      const ContactKey& k = contacts.key[c];
-      sums[k.a].force -= motion::load(contacts.force[c]);
-      sums[k.a].moment += motion::load(share_moment_[c]);
-      if (want_stiffness) add_row_stiffness(c, balls.radius[k.a], ball_k_tran_[k.a], ball_k_rot_[k.a]);
+  motion::ContactSums* __restrict sums = ball_sums_.data();
+  for (const CrossShare& s : list)
+    if (s.b >= first && s.b < last) {
+      sums[s.b].force += motion::load(s.force);
+      sums[s.b].moment += motion::load(s.moment);
+      if (want_stiffness)
+        add_stiffness(s.k_tran, s.k_shear, balls.radius[s.b], s.gap, ball_k_tran_[s.b], ball_k_rot_[s.b]);
     }
+}
+
+void Simulation::add_wall_rows(std::size_t k0, std::size_t k1) {
+  const bool want_stiffness = settings.auto_timestep || settings.density_scaling;
+  motion::ContactSums* __restrict sums = ball_sums_.data();
+  for (std::size_t k = k0; k < k1; ++k) {
+    const std::uint32_t c = wall_rows_[k];
+    const std::size_t a = contacts.key[c].a;
+    sums[a].force -= motion::load(contacts.force[c]);
+    sums[a].moment += motion::load(share_moment_[c]);
+    if (want_stiffness) add_row_stiffness(c, balls.radius[a], ball_k_tran_[a], ball_k_rot_[a]);
+  }
+}
+
+void Simulation::collect_forces(bool ball_ends_added) {
+  // Unless the threads added them themselves (use_owner_sums), the end of every ball's force sum
+  // (the order of force_pass): the shares of rows whose second ball lay beyond the range of the
+  // thread that ran them, in descending row order (the threads' ranges from the last down, each
+  // thread's list in the order it was made), then each ball's wall rows in row order. Then the
+  // walls' sums. Rows that are not active contacts hold zero force and moment.
+  const bool want_stiffness = settings.auto_timestep || settings.density_scaling;
+  if (!ball_ends_added) {
+    for (std::size_t t = crossing_.size(); t-- > 0;) add_crossing(crossing_[t], 0, ball_sums_.size());
+    add_wall_rows(0, wall_rows_.size());
   }
   for (Wall& w : walls.walls) {
     w.force = w.moment = Vec3{};

@@ -325,9 +325,13 @@ class Simulation {
   // columns and share_moment_; collect_forces() sums them in row order, so the batches need no order.
   void wall_block(std::size_t k0, std::size_t k1, double dt, BlockScratch& scratch, std::size_t& bad_row,
                   std::int64_t& batched);
-  // The walls' sums; and, after a pass without use_owner_sums, the end of the balls' force sums (the
-  // crossing shares, then each ball's wall rows).
-  void collect_forces();
+  // The walls' sums; and, unless the pass's threads added them (use_owner_sums), the end of the balls'
+  // force sums (the crossing shares, then each ball's wall rows).
+  void collect_forces(bool ball_ends_added);
+  // The shares of `list` into balls first..last-1, in list order; the wall rows wall_rows_[k0..k1)
+  // into their balls, in row order (both with their stiffness terms when those are summed).
+  void add_crossing(const std::vector<CrossShare>& list, std::size_t first, std::size_t last);
+  void add_wall_rows(std::size_t k0, std::size_t k1);
   void compute_mapping(ContactStore& store, std::size_t c) const;
   // Row c becomes a contact (created by proximity) with its rule's properties.
   void create_contact(std::size_t c, const Vec3& normal);
@@ -368,7 +372,6 @@ class Simulation {
   // Per range of the split, its lowest ball with a ball-ball row into a later range: below it the
   // range's thread adds no crossing share (force_pass). Made once per split and row lists.
   std::vector<std::size_t> crossing_floor_;
-  bool owner_sums_pass_ = true;  // the last force pass ran with use_owner_sums (collect_forces)
   static constexpr std::size_t kFloorUnknown = ~std::size_t{0};
   // Per ball, Σ(k̂_n + k̂_s) [N/m] and Σ k̂_s |x_c − x|² [N m] of the last force pass (in the order of
   // the forces), valid while stiffness_ready_.
