@@ -961,7 +961,7 @@ void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
 
 void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_end, double dt, BlockScratch& scratch,
                              std::vector<CrossShare>& crossing, std::size_t& bad_row, std::int64_t& batched_count,
-                             bool count_contacts, std::size_t& full_balls) {
+                             bool count_contacts) {
   // Rows of balls a0..a1-1 (ball-ball rows, contiguous), from the last ball down and each ball's rows
   // from the last down. Existing hill and linear contacts go through the batches; new contacts and
   // the shear-displacement tracking through force_row(). Each row's share is added to both balls
@@ -1132,21 +1132,8 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
       } else {
         __builtin_prefetch(sums + ahead, 1);
       }
-      __builtin_prefetch(first_rows_.data() + ahead);
-      if (live) {
-        // Its row ranges, those of the ball eight places further (read here next time), and the
-        // records of its near pairs' second balls.
-        __builtin_prefetch(live_first_.data() + ahead);
-        if (ahead >= kPrefetchBalls) __builtin_prefetch(near_first_.data() + ahead - kPrefetchBalls);
-        if (records && ahead >= kPrefetchBalls)
-          __builtin_prefetch(near_records_.data() + near_first_[ahead - kPrefetchBalls]);
-        // (Only the first line of a near pair's second ball: the near check reads its position and
-        // radius. Both lines: 0.99 x, three runs; nineteenth session.)
-        for (std::size_t k = near_first_[ahead]; k < near_first_[ahead + 1]; ++k) {
-          const std::size_t b = records ? near_records_[k].b : keys[near_rows_[k]].b;
-          __builtin_prefetch(kin + b);
-        }
-      }
+      // Its row range: of its live rows, or of all its rows.
+      __builtin_prefetch(live ? live_first_.data() + ahead : first_rows_.data() + ahead);
     }
     // Ball a's rows from the last down: k1 − 1 down to k0 of the row sequence row_at, its live rows
     // (live_rows) or all of its rows.
@@ -1192,8 +1179,9 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
                       static_cast<std::uint32_t>(b), image);
           bool fresh;
           if (live_rows) {
-            // A live row is a contact but for those deleted since the list was made, so the branch
-            // on `exists` is taken rarely, and the balls' records are read only then.
+            // A live row is mostly a contact (≈ 90 % in the bench bed; the others are neighbour
+            // pairs within reach of one, and contacts deleted since the list was made), so the
+            // branch on `exists` is mostly not taken, and the balls' records are read only then.
             fresh = !exists && within_reach(ka, b, image);
           } else {
             // All rows (branchless): whether a row is a contact follows no pattern the branch
@@ -1229,29 +1217,11 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
                   contacts.image[c]);
       }
     };
-    // A ball with a near pair that is a contact (made since the list) or within reach now (to be
-    // made) visits all its rows: the pair is not among its live rows.
-    bool full = false;
-    if (live) {
-      if (records) {
-        for (std::size_t k = near_first_[a]; k < near_first_[a + 1]; ++k) {
-          const NearRecord& q = near_records_[k];
-          full |= q.exists || within_reach(ka, q.b, q.image);
-        }
-      } else {
-        for (std::size_t k = near_first_[a]; k < near_first_[a + 1]; ++k) {
-          const std::size_t c = near_rows_[k];
-          full |= contacts.exists[c] || within_reach(ka, keys[c].b, contacts.image[c]);
-        }
-      }
-      full_balls += full;
-    }
-    if (live && !full && records) {
+    if (records) {
       // Ball a's live rows from the last down, through their records (use_live_records): the loop of
-      // run_rows for live rows, with the record of each row in place of its nine columns. (The near
-      // check above reads the near rows' records for the same reason: with the row columns no longer
-      // streamed ahead by this loop, the near rows' flags and keys missed the cache, and the records
-      // without them ran at 0.89-0.93 x; docs/performance.md, eighteenth session.)
+      // run_rows for live rows, with the record of each row in place of its nine columns. A row that
+      // is no contact (a neighbour pair within reach of one, or a contact deleted since the list)
+      // is checked for reach from the record and its second ball's, which the lanes read anyway.
       LiveRecord* rec = live_records_.data();
       for (std::size_t k = live_first_[a + 1]; k-- > live_first_[a];) {
         if (far) {
@@ -1290,19 +1260,9 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
         // Another model keeps its history and flags in the columns: this one row as run_rows takes it.
         run_rows(k + 1, k, [rec](std::size_t j) -> std::size_t { return rec[j].row; }, true);
       }
-    } else if (live && !full) {
+    } else if (live) {
       const std::uint32_t* rows = live_rows_.data();
       run_rows(live_first_[a + 1], live_first_[a], [rows](std::size_t k) -> std::size_t { return rows[k]; }, true);
-    } else if (records) {
-      // A ball that visits all its rows, through the columns: its live rows' history into them first,
-      // and back into the records (and the near rows' flags) once its lanes have run.
-      for (std::size_t k = live_first_[a]; k < live_first_[a + 1]; ++k) write_back(live_records_[k]);
-      run_rows(first_rows_[a + 1], first_rows_[a], [](std::size_t k) { return k; }, false);
-      if (hill.size() > 0) flush(hill);
-      if (linear.size() > 0) flush(linear);
-      for (std::size_t k = live_first_[a]; k < live_first_[a + 1]; ++k) load_live_record(k);
-      for (std::size_t k = near_first_[a]; k < near_first_[a + 1]; ++k)
-        near_records_[k].exists = contacts.exists[near_records_[k].row];
     } else {
       run_rows(first_rows_[a + 1], first_rows_[a], [](std::size_t k) { return k; }, false);
     }
@@ -1420,14 +1380,13 @@ bool Simulation::balance_speeds() {
 
 bool Simulation::split_by_live_rows() const {
   const std::size_t n = balls.size();
-  return live_now_ && live_ready_ && live_first_.size() == n + 1 && near_first_.size() == n + 1;
+  return live_now_ && live_ready_ && live_first_.size() == n + 1;
 }
 
 void Simulation::split_work(int threads) {
   // Work of ball i in the pass, in units of a neighbour row that is not a contact, and two for the
   // ball itself (its record, its half of the force sum). With the live rows (split_by_live_rows):
-  // one for each near row (the near check) and four for each live row (gather, law and scatter);
-  // the lists hold these counts already. Otherwise: each of its rows, and three more for each that
+  // four for each live row (gather, law and scatter); the list holds these counts already. Otherwise: each of its rows, and three more for each that
   // was a contact in the last pass (ball_contacts_, counted by that pass from every row's flag: a
   // read that, on every two-thread pass, cost 1.07-1.10 x at 100,800 spheres). And four for each of
   // its wall rows, which its thread runs (use_owner_sums).
@@ -1445,7 +1404,7 @@ void Simulation::split_work(int threads) {
   const bool live = split_by_live_rows();
   const bool have_counts = ball_contacts_.size() == n;
   for (std::size_t i = 0; i < n; ++i) {
-    const std::uint64_t rows = live ? (near_first_[i + 1] - near_first_[i]) + 4 * (live_first_[i + 1] - live_first_[i])
+    const std::uint64_t rows = live ? 4 * (live_first_[i + 1] - live_first_[i])
                                     : (first_rows_[i + 1] - first_rows_[i]) + (have_counts ? 3 * ball_contacts_[i] : 0);
     prefix[i + 1] = prefix[i] + 2 + rows + 4 * (wall_rows_start_[i + 1] - wall_rows_start_[i]);
   }
@@ -1486,46 +1445,35 @@ void Simulation::refresh_live_rows() {
   const std::size_t n = balls.size();
   const double proximity = settings.proximity;
   const double slack = live_slack_;
-  // Each ball-ball row: live (a contact, or not a hill row), near (a hill neighbour pair within
-  // proximity + 2 s, with a margin of 1e-9 of the radii, far above the rounding of the distances and
-  // of the travel), or neither.
-  enum : std::uint8_t { kNeither = 0, kLive = 1, kNear = 2 };
-  auto kind_of = [&](std::size_t c) -> std::uint8_t {
-    if (contacts.exists[c] || contacts.model[c] != ModelKind::Hill) return kLive;
+  // Each ball-ball row is live if it is a contact, not a hill row, or a hill neighbour pair within
+  // proximity + 2 s (with a margin of 1e-9 of the radii, far above the rounding of the distances and
+  // of the travel). Such a pair was once kept apart, as a near row that sent its ball through all
+  // its rows once it became a contact; as a live row it costs its record, and each new contact no
+  // more than its own row (docs/performance.md, twenty-first session).
+  auto is_live = [&](std::size_t c) -> std::uint8_t {
+    if (contacts.exists[c] || contacts.model[c] != ModelKind::Hill) return 1;
     const ContactKey& k = contacts.key[c];
     Vec3 xb = ball_kin_[k.b].position;
     if (contacts.image[c] != kNoImage) xb += image_shift(contacts.image[c], settings.box);
     const double radii = ball_kin_[k.a].radius + ball_kin_[k.b].radius;
     const double reach = (radii + proximity + 2.0 * slack) * (1.0 + 1e-9);
-    return norm2(xb - ball_kin_[k.a].position) > reach * reach ? kNeither : kNear;
+    return norm2(xb - ball_kin_[k.a].position) > reach * reach ? 0 : 1;
   };
-  std::vector<std::uint8_t> kind(contacts.size(), kNeither);
+  std::vector<std::uint8_t> live(contacts.size(), 0);
   live_first_.assign(n + 1, 0);
-  near_first_.assign(n + 1, 0);
 #pragma omp parallel for schedule(static) if (n > kParallelMin)
   for (std::size_t a = 0; a < n; ++a) {
-    std::uint32_t live = 0, near = 0;
-    for (std::size_t c = first_rows_[a]; c < first_rows_[a + 1]; ++c) {
-      kind[c] = kind_of(c);
-      live += kind[c] == kLive;
-      near += kind[c] == kNear;
-    }
-    live_first_[a + 1] = live;
-    near_first_[a + 1] = near;
+    std::uint32_t count = 0;
+    for (std::size_t c = first_rows_[a]; c < first_rows_[a + 1]; ++c) count += live[c] = is_live(c);
+    live_first_[a + 1] = count;
   }
-  for (std::size_t a = 0; a < n; ++a) {
-    live_first_[a + 1] += live_first_[a];
-    near_first_[a + 1] += near_first_[a];
-  }
+  for (std::size_t a = 0; a < n; ++a) live_first_[a + 1] += live_first_[a];
   live_rows_.resize(live_first_[n]);
-  near_rows_.resize(near_first_[n]);
 #pragma omp parallel for schedule(static) if (n > kParallelMin)
   for (std::size_t a = 0; a < n; ++a) {
-    std::uint32_t l = live_first_[a], m = near_first_[a];
-    for (std::size_t c = first_rows_[a]; c < first_rows_[a + 1]; ++c) {
-      if (kind[c] == kLive) live_rows_[l++] = static_cast<std::uint32_t>(c);
-      if (kind[c] == kNear) near_rows_[m++] = static_cast<std::uint32_t>(c);
-    }
+    std::uint32_t l = live_first_[a];
+    for (std::size_t c = first_rows_[a]; c < first_rows_[a + 1]; ++c)
+      if (live[c]) live_rows_[l++] = static_cast<std::uint32_t>(c);
   }
   position_at_live_.resize(n);
   for (std::size_t i = 0; i < n; ++i) position_at_live_[i] = ball_kin_[i].position;
@@ -1551,21 +1499,14 @@ void Simulation::load_live_record(std::size_t k) {
 }
 
 void Simulation::build_live_records() {
-  const std::size_t live = live_rows_.size(), near = near_rows_.size();
-  live_records_.resize(live);
-  near_records_.resize(near);
+  live_records_.resize(live_rows_.size());
   const std::size_t n = balls.size();
 #pragma omp parallel for schedule(static) if (n > kParallelMin)
-  for (std::size_t a = 0; a < n; ++a) {
+  for (std::size_t a = 0; a < n; ++a)
     for (std::size_t k = live_first_[a]; k < live_first_[a + 1]; ++k) {
       live_records_[k].row = live_rows_[k];
       load_live_record(k);
     }
-    for (std::size_t k = near_first_[a]; k < near_first_[a + 1]; ++k) {
-      const std::size_t c = near_rows_[k];
-      near_records_[k] = {static_cast<std::uint32_t>(c), contacts.key[c].b, contacts.image[c], contacts.exists[c]};
-    }
-  }
   live_records_ready_ = true;
 }
 
@@ -1630,8 +1571,7 @@ void Simulation::force_pass(double dt) {
   // The live rows (use_live_rows), made again when a ball may have moved more than the slack since
   // they were (rebuild_if_needed measured it), or the rows, their models or the proximity may have
   // changed. (A
-  // contact made since, in any pass, was a live or a near row: the others were too far apart to
-  // touch.)
+  // contact made since, in any pass, was a live row: the others were too far apart to touch.)
   live_now_ = use_live_rows && use_batched_kernel && !settings.track_shear_displacement;
   if (!terms_ready || live_rows_of_ != rows || !(live_proximity_ == settings.proximity)) live_ready_ = false;
   if (live_now_ && !(live_ready_ && live_travel_known_ && live_travel_ <= live_slack_)) refresh_live_rows();
@@ -1645,12 +1585,11 @@ void Simulation::force_pass(double dt) {
   if (live_records_ready_ && !records) sync_live_records();
   if (records && !live_records_ready_ && steps_ahead_ >= kRecordSteps) build_live_records();
   live_record_passes_ += live_records_ready_;
-  std::size_t full_balls = 0;  // balls that visited all their rows (force_block)
   const bool live_split = split_by_live_rows();
   std::unique_ptr<std::atomic<bool>[]> crossing_done;  // per thread: its crossing list is final
   const bool owner = use_owner_sums;
   std::atomic<bool> late_share{false};
-#pragma omp parallel reduction(min : bad_row) reduction(+ : batched, full_balls) if (n > kParallelMin)
+#pragma omp parallel reduction(min : bad_row) reduction(+ : batched) if (n > kParallelMin)
   {
     // ≈ 60 kB: on the heap, not the thread's stack. Default-initialised: make_unique would zero it on
     // every pass (≈ 1 % of the in-cache bed's instructions, callgrind; 1.023 x there without, 6 pairs),
@@ -1712,8 +1651,7 @@ void Simulation::force_pass(double dt) {
     if (owner && floor >= last) announce();
     if (last > first)
       for (std::size_t a = first + (last - first - 1) / block * block;; a -= block) {
-        force_block(a, std::min(last, a + block), last, dt, *scratch, crossing, bad_row, batched, count_contacts,
-                    full_balls);
+        force_block(a, std::min(last, a + block), last, dt, *scratch, crossing, bad_row, batched, count_contacts);
         if (owner && !announced && a <= floor) announce();
         if (a == first) break;
       }
@@ -1746,9 +1684,6 @@ void Simulation::force_pass(double dt) {
   if (late_share.load()) throw RunError("internal error: a crossing share after its list was final (force_pass)");
   batched_rows_ = batched;
   body_terms_ready_ = true;
-  // Many balls visiting all their rows (their new contacts are not live rows): the list is made
-  // again before the next pass.
-  if (live_now_ && full_balls > 64 + near_rows_.size() / 64) live_ready_ = false;
   ++live_passes_;
   if (bad_row < rows) {
     const ContactKey& key = contacts.key[bad_row];

@@ -135,14 +135,13 @@ class Simulation {
   // does, and the loop without the branch is 1.14 x faster (docs/performance.md, thirteenth session).
   bool use_branchless_rows = true;
   std::size_t branchless_rows_min = std::size_t{1} << 15;
-  // The row loop visits only the live rows: the contacts and the rows of other models than hill,
-  // when the lists were made. A ball whose near rows (the hill neighbour pairs within proximity + 2 s
-  // then) hold a contact or a pair within reach visits all its rows. The lists are made again when
-  // any ball has moved more than s since (the slack s adapts to how fast the balls move,
-  // refresh_live_rows), so a pair on neither list cannot have come within reach, and gives nothing:
-  // the sums and their order are those of all rows, the same bits either way (test
-  // HillBatch.LiveRowsOrAllRowsGiveTheSameBits). In the settled bench bed ≈ 40 % of the rows are on
-  // neither list, and the loop skips them (docs/performance.md, fourteenth session).
+  // The row loop visits only the live rows: the contacts, the rows of other models than hill, and
+  // the hill neighbour pairs within proximity + 2 s, when the list was made. The list is made again
+  // when any ball has moved more than s since (the slack s adapts to how fast the balls move,
+  // refresh_live_rows), so a pair not on it cannot have come within reach, and gives nothing: the
+  // sums and their order are those of all rows, the same bits either way (test
+  // HillBatch.LiveRowsOrAllRowsGiveTheSameBits). In the settled bench bed ≈ 40 % of the rows are not
+  // on it, and the loop skips them (docs/performance.md, fourteenth and twenty-first sessions).
   bool use_live_rows = true;
   // How often the live rows were made.
   std::int64_t live_row_refreshes() const { return live_refreshes_; }
@@ -169,8 +168,7 @@ class Simulation {
   bool use_owner_sums = true;
   // Within a cycle() call, on the steps nobody looks at, the row loop reads and writes each live row
   // through a record of one cache line in live-row order (its second ball, image, flags, parameter
-  // set, n̂_c and F^h_s), and each near row through a small record of its own, instead of through the
-  // row columns: one memory stream a row instead of nine. The records hold the live hill rows' history
+  // set, n̂_c and F^h_s) instead of through the row columns: one memory stream a row instead of nine. The records hold the live hill rows' history
   // until they are written back into the columns (sync_live_records): before any step someone looks
   // at, at the end of every cycle() call, before a rebuild or a new live list, and when a step
   // throws, so the columns are current wherever anyone outside the force pass reads them. The same
@@ -315,11 +313,10 @@ class Simulation {
   // The rows of balls a0..a1-1 (ball-ball), summed into both balls (see force_pass for the order);
   // a second ball at or beyond range_end (outside this thread's range) gets its share in `crossing`.
   // bad_row: the lowest row with a non-finite force; batched: + the rows that went through a batch.
-  // count_contacts: also count each ball's contacts for the next pass's split_work. full_balls: + the
-  // balls that visited all their rows, not only their live rows.
+  // count_contacts: also count each ball's contacts for the next pass's split_work.
   void force_block(std::size_t a0, std::size_t a1, std::size_t range_end, double dt, BlockScratch& scratch,
                    std::vector<CrossShare>& crossing, std::size_t& bad_row, std::int64_t& batched,
-                   bool count_contacts, std::size_t& full_balls);
+                   bool count_contacts);
   // The wall rows wall_rows_[k0..k1): existing linear contacts that touch their wall through a linear
   // batch (the wall's geometry given), the rest row by row (force_row). Each row's results go to its
   // columns and share_moment_; collect_forces() sums them in row order, so the batches need no order.
@@ -420,7 +417,7 @@ class Simulation {
   // Per ball, its rows that were contacts in the last pass with more than one thread and without
   // the live rows (split_work).
   std::vector<std::uint32_t> ball_contacts_;
-  bool split_by_live_rows() const;  // split_work weighs the balls by their live and near rows
+  bool split_by_live_rows() const;  // split_work weighs the balls by their live rows
   std::vector<std::size_t> work_start_;        // threads' ranges of balls in the force pass (split_work)
   std::vector<std::uint64_t> work_prefix_;     // split_work's running sum of work per ball
   std::size_t split_rows_ = 0;                 // rows when the split was made
@@ -448,16 +445,12 @@ class Simulation {
   void refresh_param_sets();
   std::vector<double> scaled_mass_, scaled_inertia_;  // density scaling [kg], [kg m²]
   // The live rows (use_live_rows): per ball (live_first_, as first_rows_), in row order, its
-  // ball-ball rows that were live when the lists were made (refresh_live_rows), at the positions
-  // position_at_live_ [m]. While no ball has moved more than live_slack_ [m] since, a pair on
-  // neither list is still beyond proximity, so new contacts come only from live or near rows.
+  // ball-ball rows that were live when the list was made (refresh_live_rows), at the positions
+  // position_at_live_ [m]: contacts, rows of other models, and hill neighbour pairs within
+  // proximity + 2 live_slack_ [m]. While no ball has moved more than live_slack_ since, a pair not on
+  // the list is still beyond proximity, so new contacts come only from live rows.
   std::vector<std::uint32_t> live_rows_;
   std::vector<std::uint32_t> live_first_;
-  // The near rows: per ball (near_first_), in row order, its hill neighbour pairs within proximity +
-  // 2 live_slack_ when the list was made. A ball with one that is a contact or within reach visits
-  // all its rows (force_block).
-  std::vector<std::uint32_t> near_rows_;
-  std::vector<std::uint32_t> near_first_;
   std::vector<Vec3> position_at_live_;
   double live_slack_ = 0.0;
   std::size_t live_rows_of_ = 0;   // rows when the list was made
@@ -489,14 +482,7 @@ class Simulation {
     Vec3 shear;   // F^h_s [N]
   };
   static_assert(sizeof(LiveRecord) == 64);
-  // The near rows' records, in near-row order (near_rows_): what the near check reads.
-  struct NearRecord {
-    std::uint32_t row = 0, b = 0;
-    ImageCode image = kNoImage;
-    std::uint8_t exists = 0;
-  };
   std::vector<LiveRecord> live_records_;
-  std::vector<NearRecord> near_records_;
   bool live_records_ready_ = false;   // the records hold the live hill rows' history
   std::int64_t steps_ahead_ = 0;      // steps of the current cycle() call after this one
   std::int64_t live_record_passes_ = 0;
