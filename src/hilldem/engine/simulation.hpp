@@ -369,6 +369,7 @@ class Simulation {
   // Per range of the split, its lowest ball with a ball-ball row into a later range: below it the
   // range's thread adds no crossing share (force_pass). Made once per split and row lists.
   std::vector<std::size_t> crossing_floor_;
+  std::size_t row_span_ = 0;  // the largest b − a of a ball-ball row (build_row_lists)
   static constexpr std::size_t kFloorUnknown = ~std::size_t{0};
   // Per ball, Σ(k̂_n + k̂_s) [N/m] and Σ k̂_s |x_c − x|² [N m] of the last force pass (in the order of
   // the forces), valid while stiffness_ready_.
