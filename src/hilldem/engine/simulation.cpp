@@ -1388,10 +1388,11 @@ bool Simulation::split_by_live_rows() const {
 void Simulation::split_work(int threads) {
   // Work of ball i in the pass, in units of a neighbour row that is not a contact, and two for the
   // ball itself (its record, its half of the force sum). With the live rows (split_by_live_rows):
-  // four for each live row (gather, law and scatter); the list holds these counts already. Otherwise: each of its rows, and three more for each that
-  // was a contact in the last pass (ball_contacts_, counted by that pass from every row's flag: a
-  // read that, on every two-thread pass, cost 1.07-1.10 x at 100,800 spheres). And four for each of
-  // its wall rows, which its thread runs (use_owner_sums).
+  // four for each live row (gather, law and scatter); the list holds these counts already.
+  // Otherwise: each of its rows, and three more for each that was a contact in the last pass
+  // (ball_contacts_, counted by that pass from every row's flag: a read that, on every two-thread
+  // pass, cost 1.07-1.10 x at 100,800 spheres). And four for each of its wall rows, which its thread
+  // runs (use_owner_sums).
   // Threads get ranges of equal work, not of equal numbers of balls: rows and contacts per ball vary
   // across a specimen (denser at the bottom of a bed, none above its surface), and with equal
   // numbers of balls one thread waited at the end of the pass (a third of its time on an unsettled
@@ -1643,9 +1644,9 @@ void Simulation::force_pass(double dt) {
     // not change until the next). Below it the thread adds no crossing share, and from there its list
     // is final and announced (crossing_done), long before its pass ends: the blocks run from the
     // last down, and the crossing rows are those of its top layer of balls.
-    // Only the range's top row_span_ balls can have such a row, and the last range has none: the scan
-    // over the whole range from its bottom, each time the split moved, took ≈ 2 % of a one-thread step
-    // at 100,800 spheres (twenty-first session).
+    // Only the range's top row_span_ balls can have such a row, and the last range has none. (The scan
+    // of the whole range from its bottom, which one thread made on every pass, cost it 1.03-1.05 x at
+    // 100,800 spheres; twenty-first session.)
     if (owner && crossing_floor_[t] == kFloorUnknown) {
       std::size_t floor = last;
       for (std::size_t a = last - std::min(last - first, row_span_); last < n && a < last && floor == last; ++a)

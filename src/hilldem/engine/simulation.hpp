@@ -168,10 +168,11 @@ class Simulation {
   bool use_owner_sums = true;
   // Within a cycle() call, on the steps nobody looks at, the row loop reads and writes each live row
   // through a record of one cache line in live-row order (its second ball, image, flags, parameter
-  // set, n̂_c and F^h_s) instead of through the row columns: one memory stream a row instead of nine. The records hold the live hill rows' history
-  // until they are written back into the columns (sync_live_records): before any step someone looks
-  // at, at the end of every cycle() call, before a rebuild or a new live list, and when a step
-  // throws, so the columns are current wherever anyone outside the force pass reads them. The same
+  // set, n̂_c and F^h_s) instead of through the row columns: one memory stream a row instead of nine.
+  // The records hold the live hill rows' history until they are written back into the columns
+  // (sync_live_records): before any step someone looks at, at the end of every cycle() call, before a
+  // rebuild or a new live list, and when a step throws, so the columns are current wherever anyone
+  // outside the force pass reads them. The same
   // bits either way (test HillBatch.LiveRecordsOrColumnsGiveTheSameBits): 1.07-1.08 x at 100,800
   // spheres, 1.03-1.05 x at 11,200 (docs/performance.md, eighteenth session).
   bool use_live_records = true;
