@@ -1643,14 +1643,15 @@ void Simulation::force_pass(double dt) {
     // The lowest ball of the range with a row into a later range (made once per split: the rows do
     // not change until the next). Below it the thread adds no crossing share, and from there its list
     // is final and announced (crossing_done), long before its pass ends: the blocks run from the
-    // last down, and the crossing rows are those of its top layer of balls.
-    // Only the range's top row_span_ balls can have such a row, and the last range has none. (The scan
-    // of the whole range from its bottom, which one thread made on every pass, cost it 1.03-1.05 x at
-    // 100,800 spheres; twenty-first session.)
+    // last down, and the crossing rows are those of its top layer of balls: only its top row_span_
+    // balls can have one, and the last range has none. (The scan of the whole range from its bottom,
+    // which one thread made on every pass, cost it 1.03-1.05 x at 100,800 spheres; twenty-first
+    // session.)
     if (owner && crossing_floor_[t] == kFloorUnknown) {
       std::size_t floor = last;
-      for (std::size_t a = last - std::min(last - first, row_span_); last < n && a < last && floor == last; ++a)
-        if (first_rows_[a + 1] > first_rows_[a] && contacts.key[first_rows_[a + 1] - 1].b >= last) floor = a;
+      if (last < n)
+        for (std::size_t a = last - std::min(last - first, row_span_); a < last && floor == last; ++a)
+          if (first_rows_[a + 1] > first_rows_[a] && contacts.key[first_rows_[a + 1] - 1].b >= last) floor = a;
       crossing_floor_[t] = floor;
     }
     const std::size_t floor = crossing_floor_[t];
