@@ -27,13 +27,6 @@ Command add_bench_command(CLI::App& app) {
                         std::to_string(Simulation::kDefaultBallsPerBlock) +
                         "); a tuning knob, results do not depend on it")
       ->check(CLI::Range(0, 1000000));
-  bench->add_option("--alternate", o->alternate,
-                    "time an engine switch that leaves the results' bits unchanged: the timed steps in blocks "
-                    "with it off and on in turn (this machine's speed swings within minutes; both settings see "
-                    "the same swings); prints both rates and their ratio")
-      ->check(CLI::IsMember(alternate_switches()));
-  bench->add_option("--alternate-block", o->alternate_block, "steps per block of --alternate (default 20)")
-      ->check(CLI::Range(1, 1000000));
   bench->add_flag("--memory", *memory,
                   "instead of timing the bed: the memory bandwidth of one core in GB/s (STREAM copy and triad, "
                   "the triad's real traffic with write-allocate, and a read-modify-write update; 3 x 256 MiB), "

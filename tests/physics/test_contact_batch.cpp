@@ -1,5 +1,6 @@
-// The batched hill and linear laws (engine/contact_batch.hpp) against the row-by-row laws (force_row):
-// the same contacts, forces and motion to rounding, dry and wet, with creation, deletion and rupture.
+// The batched hill and linear laws (engine/contact_batch.hpp) against the row-by-row laws (force_row,
+// which takes every row while each contact's shear displacement is tracked): the same contacts,
+// forces and motion to rounding, dry and wet, with creation, deletion and rupture.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -44,7 +45,7 @@ double worst_position_gap(const Outcome& x, const Outcome& y) {
 // and their bridges rupture.
 Simulation wet_box(bool batched) {
   Simulation sim = random_box(600, 21);
-  sim.use_batched_kernel = batched;
+  sim.settings.track_shear_displacement = !batched;  // (every row through force_row)
   sim.settings.gravity = {0, 0, -9.81};
   sim.settings.auto_timestep = true;
   sim.make_wet(20e3, 0.5e-3);
@@ -136,7 +137,7 @@ Simulation periodic_cloud() {
 TEST(HillBatch, SameMotionInAPeriodicBox) {
   auto run = [](bool batched) {
     Simulation sim = periodic_cloud();
-    sim.use_batched_kernel = batched;
+    sim.settings.track_shear_displacement = !batched;  // (every row through force_row)
     sim.make_wet(20e3, 0.5e-3);  // (its rebuild wraps the positions into the box)
     std::size_t across = 0;
     for (std::size_t c = 0; c < sim.contacts.size(); ++c) across += sim.contacts.exists[c] && sim.contacts.image[c] != kNoImage;
@@ -154,20 +155,6 @@ TEST(HillBatch, SameMotionInAPeriodicBox) {
   EXPECT_LT(worst_position_gap(batch, rows), 1e-12);
 }
 
-// The periodic box after `configure` set an engine switch: 300 steps dry (the fast grains collide:
-// new contacts between the batched ones), then 300 wet.
-// (live_refreshes: how often the live rows were made, Simulation::live_row_refreshes.)
-template <class Configure>
-Outcome periodic_wet_run(Configure configure, std::int64_t* live_refreshes = nullptr) {
-  Simulation sim = periodic_cloud();
-  configure(sim);
-  sim.cycle(300);
-  sim.make_wet(20e3, 0.5e-3);
-  sim.cycle(300);
-  if (live_refreshes) *live_refreshes = sim.live_row_refreshes();
-  return outcome(sim);
-}
-
 void expect_same_bits(const Outcome& a, const Outcome& b) {
   EXPECT_GT(a.batched, 50);
   EXPECT_EQ(a.contacts, b.contacts);
@@ -180,73 +167,18 @@ void expect_same_bits(const Outcome& a, const Outcome& b) {
   }
 }
 
-// The lanes' ball fields transposed from whole records (AVX-512 builds) or copied lane by lane: the
-// same arithmetic, so the same bits, across periodic boundaries (images) and with both laws' lanes.
-TEST(HillBatch, BallFieldsTransposedOrCopiedGiveTheSameBits) {
-  expect_same_bits(periodic_wet_run([](Simulation& s) { s.use_vector_fill = true; }),
-                   periodic_wet_run([](Simulation& s) { s.use_vector_fill = false; }));
-}
-
-// The row loop with or without a branch on whether a row is a contact (at any number of rows here):
-// the same lanes in the same order, new contacts (force_row) in their place among them, so the same
-// bits.
-TEST(HillBatch, RowsWithOrWithoutTheContactBranchGiveTheSameBits) {
-  const Outcome branchless = periodic_wet_run([](Simulation& s) {
-    s.use_branchless_rows = true;
-    s.branchless_rows_min = 0;
-  });
-  const Outcome branchy = periodic_wet_run([](Simulation& s) { s.use_branchless_rows = false; });
-  expect_same_bits(branchless, branchy);
-}
-
-// The row loop over the live rows (use_live_rows) or over all rows: the pairs left out cannot come
-// within reach before the list is made again, the near pairs that do (new contacts) send their
-// ball through all its rows, so the same contacts are made at the same steps, summed in the same
-// order: the same bits, dry and wet, with the row loop with and without its contact branch, and with
-// the travel since the list bounded or measured every step. The fast grains make the list be made
-// again often (its slack grows), and make new contacts among the lanes.
-TEST(HillBatch, LiveRowsOrAllRowsGiveTheSameBits) {
-  for (const bool branchless : {true, false}) {
-    auto configure = [branchless](bool live) {
-      return [branchless, live](Simulation& s) {
-        s.use_branchless_rows = branchless;
-        s.branchless_rows_min = 0;
-        s.use_live_rows = live;
-      };
-    };
-    std::int64_t refreshes = 0, refreshes_measured = 0;
-    const Outcome live = periodic_wet_run([&](Simulation& s) { configure(true)(s); }, &refreshes);
-    const Outcome all = periodic_wet_run(configure(false));
-    expect_same_bits(live, all);
-    EXPECT_GT(refreshes, 10);  // (made again on the way, not only at the neighbour-list rebuilds)
-    // The travel since the list measured ball by ball every step instead of bounded (use_live_bound).
-    const Outcome measured = periodic_wet_run(
-        [&](Simulation& s) {
-          configure(true)(s);
-          s.use_live_bound = false;
-        },
-        &refreshes_measured);
-    expect_same_bits(measured, all);
-    EXPECT_GT(refreshes_measured, 10);
-  }
-}
-
-// The live rows through their records (use_live_records) or through the row columns: the same lanes
-// with the same inputs in the same order, so the same bits, dry and wet, with the row loop with and
-// without its contact branch, and with the records' lanes filled and scattered eight at a time or
-// lane by lane (use_vector_fill, use_vector_scatter). The run is cut into cycle() calls of 37 steps
+// Every step watched (an observer: the live rows through the row columns) or not (through their
+// records): the same lanes with the same inputs in the same order, so the same bits, dry and wet.
+// The run is cut into cycle() calls of 37 steps
 // (the last step of each, looked at, goes through the columns), and make_wet between them reads and
 // changes the columns, so the records' history (n̂_c, F^h_s, M) must be back in the columns after
 // every call: they are compared bit for bit at the end.
 TEST(HillBatch, LiveRecordsOrColumnsGiveTheSameBits) {
-  for (const auto& [branchless, proximity] : {std::pair{true, 0.0}, std::pair{false, 0.0}, std::pair{true, 1e-3}}) {
-    auto run = [branchless, proximity](bool records, bool vectors = true) {
+  for (const double proximity : {0.0, 1e-3}) {
+    auto run = [proximity](bool records) {
       Simulation sim = periodic_cloud();
       sim.settings.proximity = proximity;
-      sim.use_branchless_rows = branchless;
-      sim.branchless_rows_min = 0;
-      sim.use_live_records = records;
-      sim.use_vector_fill = sim.use_vector_scatter = vectors;
+      if (!records) sim.observers.push_back([](const Simulation&) {});
       for (int k = 0; k < 8; ++k) sim.cycle(37);
       sim.make_wet(20e3, 0.5e-3);
       for (int k = 0; k < 4; ++k) sim.cycle(37);
@@ -255,12 +187,11 @@ TEST(HillBatch, LiveRecordsOrColumnsGiveTheSameBits) {
       for (int k = 0; k < 16; ++k) sim.cycle(37);
       return sim;
     };
-    const Simulation on = run(true), off = run(false), lane_by_lane = run(true, false);
+    const Simulation on = run(true), off = run(false);
     EXPECT_GT(on.live_record_passes(), 200);
     EXPECT_EQ(off.live_record_passes(), 0);
     const Outcome a = outcome(on), b = outcome(off);
     expect_same_bits(a, b);
-    expect_same_bits(outcome(lane_by_lane), b);  // (the records read and written lane by lane)
     EXPECT_GT(a.wet, 20u);
     EXPECT_EQ(a.wet, b.wet);
     EXPECT_EQ(a.ruptured, b.ruptured);
@@ -283,7 +214,7 @@ TEST(HillBatch, LiveRecordsOrColumnsGiveTheSameBits) {
 TEST(HillBatch, RuptureAtTheSameStep) {
   auto run = [](bool batched) {
     Simulation sim = granite_row({0.2e-3});
-    sim.use_batched_kernel = batched;
+    sim.settings.track_shear_displacement = !batched;  // (every row through force_row)
     sim.make_wet(20e3, 0.5e-3);
     sim.balls.velocity[1] = {10.0, 0, 0};  // [m/s] apart: enough to break a 1.6 N bridge
     std::int64_t broke_at = -1;
@@ -305,10 +236,11 @@ TEST(HillBatch, RuptureAtTheSameStep) {
 // and without the records. (A stale M = 2 would rupture again at once wherever the gap is beyond the
 // bridge's reach, so only a bridge that closed again before the records were written back could
 // tell; the records are written back whenever the live list is made again, every few µm of travel.)
+// Without the records: every step watched by an observer.
 TEST(HillBatch, RuptureInALiveRecordReachesTheColumns) {
   auto run = [](bool records) {
     Simulation sim = granite_row({0.2e-3});  // radii 5 mm, centres 10.2 mm apart
-    sim.use_live_records = records;
+    if (!records) sim.observers.push_back([](const Simulation&) {});
     sim.settings.proximity = 20e-3;  // [m] the contact outlives its bridge
     sim.table.rules.push_back(linear_wall_rule(500e6, 0.0));
     Wall w;
@@ -355,7 +287,7 @@ Simulation falling_linear_box() {
 TEST(LinearBatch, SameMotionAsTheRowByRowLaw) {
   auto run = [](bool batched) {
     Simulation sim = falling_linear_box();
-    sim.use_batched_kernel = batched;
+    sim.settings.track_shear_displacement = !batched;  // (every row through force_row)
     sim.cycle(4000);
     return outcome(sim);
   };
@@ -368,11 +300,12 @@ TEST(LinearBatch, SameMotionAsTheRowByRowLaw) {
 }
 
 // Linear ball-ball rows are live rows too: through their records, their flags and history stay in the
-// columns (only hill rows keep theirs in the record). The same bits with and without the records.
+// columns (only hill rows keep theirs in the record). The same bits with and without the records
+// (every step watched by an observer).
 TEST(LinearBatch, LiveRecordsGiveTheSameBits) {
   auto run = [](bool records) {
     Simulation sim = falling_linear_box();
-    sim.use_live_records = records;
+    if (!records) sim.observers.push_back([](const Simulation&) {});
     for (int k = 0; k < 10; ++k) sim.cycle(400);
     return sim;
   };
@@ -453,7 +386,7 @@ TEST(WallBatch, SameMotionAsTheRowByRowLawWithMovingWalls) {
     roof.vertex[2] = {-0.02, 0.01, h0 + 0.2e-3};
     roof.velocity = {0.005, 0, -0.01};  // [m/s]
     sim.walls.add(roof);
-    sim.use_batched_kernel = batched;
+    sim.settings.track_shear_displacement = !batched;  // (every row through force_row)
     sim.settings.gravity = {0, 0, -9.81};
     sim.settings.auto_timestep = false;
     sim.settings.timestep = 1e-6;  // [s]
@@ -497,7 +430,7 @@ TEST(WallBatch, WallContactsGoThroughTheBatch) {
     cylinder.shape = WallShape::Cylinder;
     cylinder.radius = 0.0149 + 5e-3 - 1e-6;  // [m] 1 µm into the cylinder
     sim.walls.add(cylinder);
-    sim.use_batched_kernel = batched;
+    sim.settings.track_shear_displacement = !batched;  // (every row through force_row)
     sim.settings.auto_timestep = false;
     sim.settings.timestep = 1e-6;
     sim.cycle(5);
@@ -517,7 +450,7 @@ TEST(WallBatch, WallContactsGoThroughTheBatch) {
 TEST(HillBatch, ContactPulledApartIsDeletedInTheBatch) {
   auto run = [](bool batched) {
     Simulation sim = granite_row({-1e-6});  // 1 µm overlap
-    sim.use_batched_kernel = batched;
+    sim.settings.track_shear_displacement = !batched;  // (every row through force_row)
     sim.balls.velocity[1] = {0.6, 0, 0};  // [m/s] away from ball 1: 0.6 µm a step
     int step = 0;
     std::int64_t batched_at_deletion = -1;
@@ -548,7 +481,7 @@ TEST(HillBatch, ContactPulledApartIsDeletedInTheBatch) {
 TEST(HillBatch, NonFiniteForceStopsTheRunNamingThePair) {
   for (const bool batched : {true, false}) {
     Simulation sim = granite_row({-1e-6});
-    sim.use_batched_kernel = batched;
+    sim.settings.track_shear_displacement = !batched;  // (every row through force_row)
     sim.cycle(1);  // the contact exists from here: the next step takes it through the batch
     ASSERT_EQ(sim.contact_count(), 1u);
     sim.balls.spin[1] = {0, 0, std::numeric_limits<double>::infinity()};

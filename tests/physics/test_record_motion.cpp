@@ -1,7 +1,8 @@
-// The law of motion on the force pass's ball records (Simulation::use_record_motion) against the law
-// on the BallStore's columns: the same law (motion/ball_step.hpp) and the same travel, so the same
-// bits; and the columns hold the balls' state whenever anyone outside the cycle can look: after
-// every cycle() call, in every observer and controller, after a run that threw.
+// Within one cycle() call the law of motion moves the force pass's ball records; the first step of a
+// call moves the BallStore's columns. Long calls against calls of one step each: the same law
+// (motion/ball_step.hpp) and the same travel, so the same bits; and the columns hold the balls'
+// state whenever anyone outside the cycle can look: after every cycle() call, in every observer and
+// controller, after a run that threw.
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -52,15 +53,24 @@ Simulation busy_box() {
   return sim;
 }
 
+// n steps in one cycle() call (records: the records carry the state from step to step), or in n calls
+// of one step (each moves the columns).
+void advance(Simulation& sim, bool records, std::int64_t n) {
+  if (records) {
+    sim.cycle(n);
+  } else {
+    for (std::int64_t k = 0; k < n; ++k) sim.cycle(1);
+  }
+}
+
 // Long cycle() calls (the records carry the state from step to step), dry then wet, in a walled box
 // and in a periodic one (rebuilds wrap the positions), and with density scaling.
 TEST(Motion, RecordsOrColumnsGiveTheSameBits) {
   auto walled = [](bool records) {
     Simulation sim = busy_box();
-    sim.use_record_motion = records;
-    sim.cycle(400);
+    advance(sim, records, 400);
     sim.make_wet(20e3, 0.5e-3);
-    sim.cycle(400);
+    advance(sim, records, 400);
     return state(sim);
   };
   const State a = walled(true), b = walled(false);
@@ -76,8 +86,7 @@ TEST(Motion, RecordsOrColumnsGiveTheSameBits) {
       sim.balls.velocity[i] *= 10.0;                    // [m/s]
       sim.balls.position[i] += Vec3{0.02, 0.013, 0.0};  // [m] the boundaries cut the cloud
     }
-    sim.use_record_motion = records;
-    sim.cycle(600);
+    advance(sim, records, 600);
     return state(sim);
   };
   const State p = periodic(true), q = periodic(false);
@@ -89,8 +98,7 @@ TEST(Motion, RecordsOrColumnsGiveTheSameBits) {
     sim.settings.auto_timestep = false;
     sim.settings.timestep = 4e-6;  // [s]
     sim.settings.density_scaling = true;
-    sim.use_record_motion = records;
-    sim.cycle(500);
+    advance(sim, records, 500);
     return state(sim);
   };
   expect_same(scaled(true), scaled(false));
@@ -102,8 +110,7 @@ TEST(Motion, RecordsOrColumnsGiveTheSameBits) {
       sim.balls.applied_force[i] = {0.0, 0.0, 0.02};  // [N]
       sim.balls.applied_moment[i] = {1e-5, 0.0, 0.0};  // [N m]
     }
-    sim.use_record_motion = records;
-    sim.cycle(300);
+    advance(sim, records, 300);
     return state(sim);
   };
   expect_same(loaded(true), loaded(false));
@@ -114,22 +121,21 @@ TEST(Motion, RecordsOrColumnsGiveTheSameBits) {
 TEST(Motion, ColumnsAreTheStateWheneverSomeoneLooks) {
   auto run = [](bool records, std::vector<Vec3>* seen) {
     Simulation sim = busy_box();
-    sim.use_record_motion = records;
-    sim.cycle(150);
+    advance(sim, records, 150);
     sim.balls.velocity[5] = {0.3, -0.2, 0.1};  // [m/s] by hand, between two calls
     sim.balls.position[6] += Vec3{0.0, 0.0, 1e-4};  // [m]
     sim.invalidate_neighbours();
-    sim.cycle(150);
+    advance(sim, records, 150);
     for (double& r : sim.balls.radius) r *= 0.7;  // [m] a new mean radius: a new skin (and new rebuilds)
     sim.refresh_mappings();
     sim.invalidate_neighbours();
-    sim.cycle(150);
+    advance(sim, records, 150);
     // (Held at 0.1 m/s upwards against gravity: the step's motion must start from it.)
     sim.controllers.push_back([](Simulation& s, double) { s.balls.velocity[7] = {0.0, 0.0, 0.1}; });  // [m/s]
     sim.observers.push_back([seen](const Simulation& s) { seen->push_back(s.balls.position[8]); });
-    sim.cycle(100);
+    advance(sim, records, 100);
     sim.controllers.clear();
-    sim.cycle(100);  // (the observer still looks)
+    advance(sim, records, 100);  // (the observer still looks)
     return state(sim);
   };
   std::vector<Vec3> seen_records, seen_columns;
@@ -142,13 +148,12 @@ TEST(Motion, ColumnsAreTheStateWheneverSomeoneLooks) {
   EXPECT_FALSE(same_bits(seen_records.front(), seen_records.back()));
 }
 
-// `steps` cycles of `sim` with the record motion on or off, to the RunError it must end in: the
+// `steps` cycles of `sim` in one call (records) or one at a time, to the RunError it must end in: the
 // error's message and the balls' state.
 std::pair<std::string, State> failing_run(Simulation sim, bool records, std::int64_t steps) {
-  sim.use_record_motion = records;
   std::string message;
   try {
-    sim.cycle(steps);
+    advance(sim, records, steps);
   } catch (const RunError& e) {
     message = e.what();
   }
@@ -208,8 +213,7 @@ TEST(Motion, ForceColumnsAreTheRowsSumsWheneverSomeoneLooks) {
   const Packing bed = read_packing(HILLDEM_SOURCE_DIR "/bench/bed_settled.data", PackingFormat::Lammps);
   for (const bool records : {true, false}) {
     Simulation sim = make_bed(bed);
-    sim.use_record_motion = records;
-    sim.cycle(200);  // (only the last step watched)
+    advance(sim, records, 200);  // (records: only the last step watched)
     EXPECT_LT(worst_force_sum_error(sim), 1e-12) << records;
     EXPECT_GT(sim.contact_count(), 20000u);
     // An observer sees each step's sums (every step watched).
@@ -220,20 +224,19 @@ TEST(Motion, ForceColumnsAreTheRowsSumsWheneverSomeoneLooks) {
   }
 }
 
-// Each thread ends its own balls' force sums (Simulation::use_owner_sums): the crossing shares from
-// the ranges below, as soon as each is final, then its balls' floor rows. One, two and three threads,
-// with and without: the same bits in the balls, and in the floor's sums after each call.
-TEST(Motion, OwnerSumsGiveTheSameBits) {
+// Each thread ends its own balls' force sums: the crossing shares from the ranges below, as soon as
+// each is final, then its balls' floor rows. One, two and three threads: the same bits in the balls,
+// and in the floor's sums after each call.
+TEST(Motion, ThreadsEndTheirOwnSumsWithTheSameBits) {
   const Packing bed = read_packing(HILLDEM_SOURCE_DIR "/bench/bed_settled.data", PackingFormat::Lammps);
   struct Run {
     State state;
     std::vector<Wall> floor;
   };
-  auto run = [&bed](int threads, bool owner) {
+  auto run = [&bed](int threads) {
     omp_set_num_threads(threads);
     Simulation sim = make_bed(bed);
     sim.settings.local_damping = 0.0;  // (the balls keep moving)
-    sim.use_owner_sums = owner;
     std::vector<Wall> floor;
     for (int k = 0; k < 3; ++k) {
       sim.cycle(40);
@@ -242,17 +245,17 @@ TEST(Motion, OwnerSumsGiveTheSameBits) {
     omp_set_num_threads(omp_get_num_procs());
     return Run{state(sim), floor};
   };
-  const Run one = run(1, false);
+  const Run one = run(1);
   EXPECT_GT(one.floor[2].active_contacts, 100u);
-  for (const auto& [threads, owner] : {std::pair{1, true}, std::pair{2, true}, std::pair{3, true}, std::pair{2, false}}) {
-    const Run other = run(threads, owner);
+  for (const int threads : {2, 3}) {
+    const Run other = run(threads);
     expect_same(one.state, other.state);
     for (std::size_t k = 0; k < one.floor.size(); ++k) {
       const Wall &a = one.floor[k], &b = other.floor[k];
-      EXPECT_TRUE(same_bits(a.force, b.force) && same_bits(a.moment, b.moment)) << threads << owner << k;
-      EXPECT_EQ(std::memcmp(&a.normal_force, &b.normal_force, sizeof(double)), 0) << threads << owner << k;
-      EXPECT_EQ(std::memcmp(&a.normal_stiffness, &b.normal_stiffness, sizeof(double)), 0) << threads << owner << k;
-      EXPECT_EQ(a.active_contacts, b.active_contacts) << threads << owner << k;
+      EXPECT_TRUE(same_bits(a.force, b.force) && same_bits(a.moment, b.moment)) << threads << k;
+      EXPECT_EQ(std::memcmp(&a.normal_force, &b.normal_force, sizeof(double)), 0) << threads << k;
+      EXPECT_EQ(std::memcmp(&a.normal_stiffness, &b.normal_stiffness, sizeof(double)), 0) << threads << k;
+      EXPECT_EQ(a.active_contacts, b.active_contacts) << threads << k;
     }
   }
 }

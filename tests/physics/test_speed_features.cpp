@@ -189,7 +189,7 @@ TEST(Threads, OneAndTwoThreadsGiveBitwiseIdenticalResults) {
 }
 
 // Two threads sharing the work unequally (as the force pass does when one core runs slower,
-// Simulation::use_speed_split): each thread's range of balls changes, the bits do not.
+// the threads' measured speeds): each thread's range of balls changes, the bits do not.
 TEST(Threads, UnequalSharesOfTheWorkGiveTheSameBits) {
   auto run = [](std::vector<double> shares) {
     omp_set_num_threads(shares.empty() ? 1 : static_cast<int>(shares.size()));

@@ -5,6 +5,7 @@
 #include <omp.h>
 
 #include "hilldem/core/error.hpp"
+#include "hilldem/io/state_io.hpp"
 
 namespace hilldem {
 
@@ -13,17 +14,10 @@ namespace hilldem {
 #endif
 
 std::string BedBenchResult::line() const {
-  if (!alternate.empty())
-    return fmt::format("particles={} steps={} alternate={} off_particle_steps_per_s={:.4g} "
-                       "on_particle_steps_per_s={:.4g} on_over_off={:.3f} contacts_per_particle={:.3f} threads={} "
-                       "rebuilds={} build={}",
-                       particles, steps, alternate, off_particle_steps_per_second, on_particle_steps_per_second,
-                       on_particle_steps_per_second / off_particle_steps_per_second, contacts_per_particle, threads,
-                       rebuilds, HILLDEM_BUILD_KIND);
   return fmt::format("particles={} steps={} wall_s={:.3f} particle_steps_per_s={:.4g} contacts_per_particle={:.3f} "
-                     "threads={} rebuilds={} build={}",
+                     "threads={} rebuilds={} build={} digest={}",
                      particles, steps, wall_seconds, particle_steps_per_second, contacts_per_particle, threads, rebuilds,
-                     HILLDEM_BUILD_KIND);
+                     HILLDEM_BUILD_KIND, digest);
 }
 
 Simulation make_bed(const Packing& packing) {
@@ -84,32 +78,6 @@ std::int64_t settle_bed(const std::string& in, const std::string& out, double ra
   return steps;
 }
 
-const std::vector<std::string>& alternate_switches() {
-  static const std::vector<std::string> names{"vector-fill", "branchless-rows", "live-rows", "speed-split",
-                                               "record-motion", "live-records", "vector-scatter", "live-bound", "owner-sums"};
-  return names;
-}
-
-namespace {
-bool& switch_of(Simulation& sim, const std::string& name) {
-  if (name == "vector-fill") return sim.use_vector_fill;
-  if (name == "branchless-rows") {
-    sim.branchless_rows_min = 0;  // (compared at any size)
-    return sim.use_branchless_rows;
-  }
-  if (name == "live-rows") return sim.use_live_rows;
-  if (name == "speed-split") return sim.use_speed_split;
-  if (name == "record-motion") return sim.use_record_motion;
-  if (name == "live-records") return sim.use_live_records;
-  if (name == "vector-scatter") return sim.use_vector_scatter;
-  if (name == "live-bound") return sim.use_live_bound;
-  if (name == "owner-sums") return sim.use_owner_sums;
-  std::string allowed;
-  for (const std::string& s : alternate_switches()) allowed += (allowed.empty() ? "" : ", ") + s;
-  throw InputError("bench --alternate: unknown switch '" + name + "' (allowed: " + allowed + ")");
-}
-}  // namespace
-
 BedBenchResult run_bed_bench(const BedBenchOptions& o) {
   if (o.threads > 0) omp_set_num_threads(o.threads);
   Packing packing = read_packing(o.data, PackingFormat::Lammps);
@@ -123,40 +91,17 @@ BedBenchResult run_bed_bench(const BedBenchOptions& o) {
   r.particles = sim.balls.size();
   r.steps = o.steps;
   const double particles = static_cast<double>(r.particles);
-  if (o.alternate.empty()) {
-    const auto start = std::chrono::steady_clock::now();
-    sim.cycle(o.steps);
-    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    r.wall_seconds = secs;
-    r.particle_steps_per_second = particles * static_cast<double>(o.steps) / secs;
-  } else {
-    if (o.alternate_block < 1) throw InputError("bench --alternate-block: must be at least 1 step");
-    bool& on = switch_of(sim, o.alternate);
-    const bool initial = on;
-    double secs[2] = {0.0, 0.0};
-    std::int64_t done[2] = {0, 0};
-    for (std::int64_t k = 0, left = o.steps; left > 0; ++k) {
-      const std::int64_t n = std::min(left, o.alternate_block);
-      on = k % 2 == 1;
-      const auto start = std::chrono::steady_clock::now();
-      sim.cycle(n);
-      secs[k % 2] += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      done[k % 2] += n;
-      left -= n;
-    }
-    on = initial;
-    r.alternate = o.alternate;
-    r.wall_seconds = secs[0] + secs[1];
-    r.particle_steps_per_second = particles * static_cast<double>(o.steps) / r.wall_seconds;
-    r.off_particle_steps_per_second = secs[0] > 0.0 ? particles * static_cast<double>(done[0]) / secs[0] : 0.0;
-    r.on_particle_steps_per_second = secs[1] > 0.0 ? particles * static_cast<double>(done[1]) / secs[1] : 0.0;
-  }
+  const auto start = std::chrono::steady_clock::now();
+  sim.cycle(o.steps);
+  r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  r.particle_steps_per_second = particles * static_cast<double>(o.steps) / r.wall_seconds;
   std::size_t ball_contacts = 0;
   for (std::size_t c = 0; c < sim.contacts.size(); ++c)
     ball_contacts += sim.contacts.active[c] && sim.contacts.key[c].kind == ContactKind::BallBall;
   r.contacts_per_particle = 2.0 * static_cast<double>(ball_contacts) / static_cast<double>(r.particles);
   r.threads = omp_get_max_threads();
   r.rebuilds = sim.rebuilds() - rebuilds0;
+  r.digest = state_digest(sim);
   return r;
 }
 

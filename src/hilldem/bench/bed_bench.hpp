@@ -19,13 +19,6 @@ struct BedBenchOptions {
   std::int64_t steps = 1000;  // timed steps
   int threads = 0;            // 0 = OpenMP default
   std::size_t block = 0;      // balls per block of the force pass (0: the engine's default); tuning only
-  // An engine switch whose two settings give the same bits ("vector-fill", "branchless-rows",
-  // "live-rows"; empty: none): the timed steps run in blocks of alternate_block steps with the
-  // switch off and on in turn, and the line gives the rate of each and their ratio. This machine's
-  // speed swings by 20-40 % within minutes; two settings timed in turn within one run see the same
-  // swings.
-  std::string alternate;
-  std::int64_t alternate_block = 20;
 };
 
 struct BedBenchResult {
@@ -37,13 +30,10 @@ struct BedBenchResult {
   int threads = 1;
   std::int64_t rebuilds = 0;           // neighbour-list rebuilds during the timed steps
   std::string line() const;            // one machine-readable line
-  // With BedBenchOptions::alternate: the switch's name and the rate with it off and on.
-  std::string alternate;
-  double off_particle_steps_per_second = 0.0, on_particle_steps_per_second = 0.0;
+  // The state digest after the timed steps (io/state_io.hpp): the same for any thread count and
+  // block size, and for any build of one source.
+  std::string digest;
 };
-
-// The engine switches `hilldem bench --alternate` knows (each leaves the results' bits unchanged).
-const std::vector<std::string>& alternate_switches();
 
 // The bed as a Simulation, ready to cycle.
 Simulation make_bed(const Packing& packing);

@@ -131,7 +131,7 @@ void Simulation::step_body(bool last) {
     i_scaled = scaled_inertia_.data();
   }
   // §1.2 steps 1-2
-  if (use_record_motion && records_current_ && ball_kin_.size() == balls.size()) {
+  if (records_current_ && ball_kin_.size() == balls.size()) {
     advance_records(dt, m_scaled, i_scaled, watched);
   } else {
     drop_records();
@@ -287,7 +287,7 @@ void Simulation::advance_records(double dt, const double* inertial_mass, const d
   const bool live_list = live_ready_ && position_at_live_.size() == n;
   // The travel since the live rows ball by ball (reading each ball's position then), or bounded
   // without it while the bound, grown by four steps like the last, stays within the slack.
-  const bool bounded = live_list && use_live_bound && live_bound_valid_ && live_travel_ + 4.0 * live_growth_ <= live_slack_;
+  const bool bounded = live_list && live_bound_valid_ && live_travel_ + 4.0 * live_growth_ <= live_slack_;
   const bool live = live_list && !bounded;
   if (!applied_known_) {  // (once per cycle() call: nothing changes them until then)
     const auto zero = [](const std::vector<Vec3>& v) {
@@ -825,7 +825,7 @@ void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
   const std::size_t n = batch.size();
   std::size_t lane = 0;
 #if defined(__AVX512F__)
-  if (use_vector_fill) {
+  {
     static_assert(sizeof(BallKin) == 128 && alignof(BallKin) == 64);
     static_assert(offsetof(BallKin, position) == 0 && offsetof(BallKin, radius) == 24 &&
                   offsetof(BallKin, velocity) == 32 && offsetof(BallKin, spin) == 56 && offsetof(BallKin, terms) == 80);
@@ -880,7 +880,7 @@ void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
     lane = n;
   }
 #endif
-  for (; lane < n; ++lane) {  // lane by lane (no AVX-512, or !use_vector_fill)
+  for (; lane < n; ++lane) {  // lane by lane (no AVX-512)
     const BallKin& ka = kin[batch.ball1(lane)];
     const BallKin& kb = kin[batch.ball2(lane)];
     batch.put3(F::kDx, lane, separation(ka, kb, batch.image(lane), settings.box));
@@ -900,7 +900,7 @@ void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
   // The rows' own inputs. (From the row columns, eight rows' Vec3s loaded whole and transposed, and
   // the parameters set for eight lanes at once, gave 1.000 x in cache, 16 pairs: not kept. From the
   // live records, one aligned line a row, it pays: below.)
-  // A hill lane's history, parameter set and M: from its live record (use_live_records), or from
+  // A hill lane's history, parameter set and M: from its live record, or from
   // the row columns.
   auto put_hill = [&](std::size_t lane, const Vec3& normal, const Vec3& shear, std::uint32_t set, Moisture m) {
     batch.put3(F::kNox, lane, normal);
@@ -912,7 +912,7 @@ void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
   };
   lane = 0;
 #if defined(__AVX512F__)
-  if (hill && use_vector_fill) {
+  if (hill) {
     // Eight lanes with live records at a time: the records loaded whole and transposed in registers
     // (n̂_c and F^h_s stored once for the eight lanes), the parameters gathered by set, M compared
     // for the eight at once. The same values as put_hill's, so the same bits.
@@ -962,8 +962,7 @@ void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
 }
 
 void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_end, double dt, BlockScratch& scratch,
-                             std::vector<CrossShare>& crossing, std::size_t& bad_row, std::int64_t& batched_count,
-                             bool count_contacts) {
+                             std::vector<CrossShare>& crossing, std::size_t& bad_row, std::int64_t& batched_count) {
   // Rows of balls a0..a1-1 (ball-ball rows, contiguous), from the last ball down and each ball's rows
   // from the last down. Existing hill and linear contacts go through the batches; new contacts and
   // the shear-displacement tracking through force_row(). Each row's share is added to both balls
@@ -971,8 +970,6 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
   // run before a row of the other batch or of force_row() is added, so the lanes keep the order.
   const double proximity = settings.proximity;
   const bool want_stiffness = settings.auto_timestep || settings.density_scaling;
-  const bool batched = use_batched_kernel && !settings.track_shear_displacement;
-  const bool branchless = batched && use_branchless_rows && contacts.size() > branchless_rows_min;
   const bool reported = write_results_;
   const PeriodicBox& box = settings.box;
   const BallKin* kin = ball_kin_.data();
@@ -999,7 +996,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
   constexpr std::size_t kPrefetchBalls = 8;
   constexpr std::size_t kPrefetchRecords = 64;
   const bool far = contacts.size() > (std::size_t{1} << 17);
-  const bool live = live_now_;  // the rows visited: the live rows (force_pass), or all
+  const bool live = live_now_;  // the rows visited: the live rows (force_pass), or all (through force_row)
   const bool records = live && live_records_ready_;  // the live rows through their records
   using F = ContactBatch;
   ContactBatch& hill = scratch.hill;
@@ -1074,7 +1071,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
     // ball's sums (one line, motion::ContactSums) added to in one operation, and n̂_c and F^h_s
     // stored into each record at once. The same additions in the same lane order (x − F is x + (−F)
     // bit for bit, and a fourth lane +0.0 stays +0.0), so the same bits as scatter_lane.
-    if (use_vector_scatter && records && &batch == &hill && !reported && !want_stiffness) {
+    if (records && &batch == &hill && !reported && !want_stiffness) {
       const double* ruptured = batch.col(F::kRuptured);
       const __m512d zero = _mm512_setzero_pd();
       const __m512i no_slot = _mm512_set1_epi64(ContactBatch::kNoSlot);
@@ -1139,7 +1136,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
     }
     // Ball a's rows from the last down: k1 − 1 down to k0 of the row sequence row_at, its live rows
     // (live_rows) or all of its rows.
-    auto run_rows = [&](std::size_t k1, std::size_t k0, auto row_at, bool live_rows) __attribute__((always_inline)) {
+    auto run_rows = [&](std::size_t k1, std::size_t k0, auto row_at) __attribute__((always_inline)) {
       for (std::size_t k = k1; k-- > k0;) {
         const std::size_t c = row_at(k);
         if (far) {  // (nothing asked for ahead when the rows fit in the caches: see above)
@@ -1170,40 +1167,27 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
         }
         const std::size_t b = keys[c].b;
         const bool exists = contacts.exists[c];
-        if ((live_rows || branchless) && contacts.model[c] == ModelKind::Hill) {
+        if (contacts.model[c] == ModelKind::Hill) {
           // A hill row, contact or neighbour pair, without a branch on which it is: the row always
-          // takes the next lane's slot, which becomes a lane only if it is a contact. Only a pair
-          // within reach that is no contact yet (a new one: rare) branches, to force_row in row order.
+          // takes the next lane's slot, which becomes a lane only if it is a contact. A live row is
+          // mostly a contact (≈ 90 % in the bench bed; the others are neighbour pairs within reach of
+          // one, and contacts deleted since the list was made), so the branch on `exists` is mostly
+          // not taken, and the balls' records are read only then. Only a pair within reach that is
+          // no contact yet (a new one: rare) goes to force_row, in row order.
           if (linear.size() > 0) flush(linear);
           if (hill.full()) flush(hill);
           const ImageCode image = contacts.image[c];
           hill.add_if(exists, static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(a),
                       static_cast<std::uint32_t>(b), image);
-          bool fresh;
-          if (live_rows) {
-            // A live row is mostly a contact (≈ 90 % in the bench bed; the others are neighbour
-            // pairs within reach of one, and contacts deleted since the list was made), so the
-            // branch on `exists` is mostly not taken, and the balls' records are read only then.
-            fresh = !exists && within_reach(ka, b, image);
-          } else {
-            // All rows (branchless): whether a row is a contact follows no pattern the branch
-            // predictor can learn once the rows outgrow its history (≈ 45 % of the bench bed's rows
-            // are neighbour pairs), so the separation is checked either way. The empty asm makes the
-            // compiler compute `near` whole, where it would otherwise branch on the separation first,
-            // which is as unpredictable as `exists`.
-            unsigned near = static_cast<unsigned>(!exists) & static_cast<unsigned>(within_reach(ka, b, image));
-            asm("" : "+r"(near));
-            fresh = near != 0;
-          }
-          if (fresh) [[unlikely]] {  // a contact from now on (force_row), in row order
+          if (!exists && within_reach(ka, b, image)) [[unlikely]] {  // a contact from now on
             if (hill.size() > 0) flush(hill);
             add_share(c, force_row(c, dt));
           }
           continue;
         }
         // A neighbour pair beyond reach gives nothing to either ball.
-        if (!exists && batched && !within_reach(ka, b, contacts.image[c])) continue;
-        if (!batched || !exists) {
+        if (!exists && !within_reach(ka, b, contacts.image[c])) continue;
+        if (!exists) {
           if (hill.size() > 0) flush(hill);
           if (linear.size() > 0) flush(linear);
           add_share(c, force_row(c, dt));
@@ -1220,7 +1204,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
       }
     };
     if (records) {
-      // Ball a's live rows from the last down, through their records (use_live_records): the loop of
+      // Ball a's live rows from the last down, through their records: the loop of
       // run_rows for live rows, with the record of each row in place of its nine columns. A row that
       // is no contact (a neighbour pair within reach of one, or a contact deleted since the list)
       // is checked for reach from the record and its second ball's, which the lanes read anyway.
@@ -1260,23 +1244,17 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
           continue;
         }
         // Another model keeps its history and flags in the columns: this one row as run_rows takes it.
-        run_rows(k + 1, k, [rec](std::size_t j) -> std::size_t { return rec[j].row; }, true);
+        run_rows(k + 1, k, [rec](std::size_t j) -> std::size_t { return rec[j].row; });
       }
     } else if (live) {
       const std::uint32_t* rows = live_rows_.data();
-      run_rows(live_first_[a + 1], live_first_[a], [rows](std::size_t k) -> std::size_t { return rows[k]; }, true);
-    } else {
-      run_rows(first_rows_[a + 1], first_rows_[a], [](std::size_t k) { return k; }, false);
+      run_rows(live_first_[a + 1], live_first_[a], [rows](std::size_t k) -> std::size_t { return rows[k]; });
+    } else {  // every row through force_row (each contact's shear displacement tracked)
+      for (std::size_t c = first_rows_[a + 1]; c-- > first_rows_[a];) add_share(c, force_row(c, dt));
     }
   }
   if (hill.size() > 0) flush(hill);
   if (linear.size() > 0) flush(linear);
-  if (count_contacts)  // for the next pass's split_work
-    for (std::size_t a = a0; a < a1; ++a) {
-      std::uint32_t count = 0;
-      for (std::size_t c = first_rows_[a]; c < first_rows_[a + 1]; ++c) count += contacts.exists[c];
-      ball_contacts_[a] = count;
-    }
 }
 
 void Simulation::wall_block(std::size_t k0, std::size_t k1, double dt, BlockScratch& scratch, std::size_t& bad_row,
@@ -1284,7 +1262,7 @@ void Simulation::wall_block(std::size_t k0, std::size_t k1, double dt, BlockScra
   // Wall rows row by row took 12 % of a lab test (perf, C5b hill test): the chain of square roots
   // and divisions of one contact at a time, as ball-ball rows before the batches.
   const bool want_stiffness = settings.auto_timestep || settings.density_scaling;
-  const bool batched = use_batched_kernel && !settings.track_shear_displacement;
+  const bool batched = !settings.track_shear_displacement;
   using F = ContactBatch;
   ContactBatch& batch = scratch.linear;
   batch.clear();
@@ -1353,7 +1331,7 @@ bool Simulation::balance_speeds() {
   // proportion to the speeds, half way from the last shares (the speeds are noisy); a new split only
   // if a share moved by more than 1 %. Which balls a thread sums changes no result (force_pass).
   const std::size_t threads = thread_share_.size();
-  if (!use_speed_split || !thread_shares.empty() || threads < 2 || thread_busy_.size() != threads ||
+  if (!thread_shares.empty() || threads < 2 || thread_busy_.size() != threads ||
       work_start_.size() != threads + 1 || work_prefix_.size() != balls.size() + 1)
     return false;
   std::vector<double> speed(threads);
@@ -1380,19 +1358,11 @@ bool Simulation::balance_speeds() {
   return moved;
 }
 
-bool Simulation::split_by_live_rows() const {
-  const std::size_t n = balls.size();
-  return live_now_ && live_ready_ && live_first_.size() == n + 1;
-}
-
 void Simulation::split_work(int threads) {
   // Work of ball i in the pass, in units of a neighbour row that is not a contact, and two for the
-  // ball itself (its record, its half of the force sum). With the live rows (split_by_live_rows):
-  // four for each live row (gather, law and scatter); the list holds these counts already.
-  // Otherwise: each of its rows, and three more for each that was a contact in the last pass
-  // (ball_contacts_, counted by that pass from every row's flag: a read that, on every two-thread
-  // pass, cost 1.07-1.10 x at 100,800 spheres). And four for each of its wall rows, which its thread
-  // runs (use_owner_sums).
+  // ball itself (its record, its half of the force sum). With the live rows: four for each live row
+  // (gather, law and scatter); the list holds these counts already. Without (every row through
+  // force_row): four for each of its rows. And four for each of its wall rows, which its thread runs.
   // Threads get ranges of equal work, not of equal numbers of balls: rows and contacts per ball vary
   // across a specimen (denser at the bottom of a bed, none above its surface), and with equal
   // numbers of balls one thread waited at the end of the pass (a third of its time on an unsettled
@@ -1405,31 +1375,27 @@ void Simulation::split_work(int threads) {
     // floor again each time.)
     const auto count = static_cast<std::size_t>(std::max(threads, 1));
     thread_share_.assign(count, 1.0 / static_cast<double>(count));
-    shares_by_speed_ = false;
     return;
   }
   std::vector<std::uint64_t>& prefix = work_prefix_;
   prefix.resize(n + 1);
   prefix[0] = 0;
-  const bool live = split_by_live_rows();
-  const bool have_counts = ball_contacts_.size() == n;
+  const bool live = live_now_ && live_ready_ && live_first_.size() == n + 1;
   for (std::size_t i = 0; i < n; ++i) {
-    const std::uint64_t rows = live ? 4 * (live_first_[i + 1] - live_first_[i])
-                                    : (first_rows_[i + 1] - first_rows_[i]) + (have_counts ? 3 * ball_contacts_[i] : 0);
-    prefix[i + 1] = prefix[i] + 2 + rows + 4 * (wall_rows_start_[i + 1] - wall_rows_start_[i]);
+    const std::uint64_t rows = live ? live_first_[i + 1] - live_first_[i] : first_rows_[i + 1] - first_rows_[i];
+    prefix[i + 1] = prefix[i] + 2 + 4 * rows + 4 * (wall_rows_start_[i + 1] - wall_rows_start_[i]);
   }
-  // Thread t's share of the work: given (thread_shares), equal, or in proportion to the threads'
-  // speeds (balance_speeds).
+  // Thread t's share of the work: given (thread_shares), or in proportion to the threads' speeds
+  // (balance_speeds; equal at first).
   const auto count = static_cast<std::size_t>(threads);
   if (thread_shares.size() == count) {
     const double sum = std::accumulate(thread_shares.begin(), thread_shares.end(), 0.0);
     thread_share_.resize(count);
     for (std::size_t t = 0; t < count; ++t)
       thread_share_[t] = sum > 0.0 ? std::max(thread_shares[t], 0.0) / sum : 1.0 / threads;
-  } else if (thread_share_.size() != count || !use_speed_split) {
+  } else if (thread_share_.size() != count) {
     thread_share_.assign(count, 1.0 / threads);
   }
-  shares_by_speed_ = thread_shares.size() != count && use_speed_split;
   double before = 0.0;
   for (std::size_t t = 1; t < count; ++t) {
     before += thread_share_[t - 1];
@@ -1577,27 +1543,24 @@ void Simulation::force_pass(double dt) {
     }
     records_current_ = true;
   }
-  ball_contacts_.resize(n);
-  // The live rows (use_live_rows), made again when a ball may have moved more than the slack since
-  // they were (rebuild_if_needed measured it), or the rows, their models or the proximity may have
-  // changed. (A
-  // contact made since, in any pass, was a live row: the others were too far apart to touch.)
-  live_now_ = use_live_rows && use_batched_kernel && !settings.track_shear_displacement;
+  // The live rows, made again when a ball may have moved more than the slack since they were
+  // (rebuild_if_needed measured it), or the rows, their models or the proximity may have changed. (A
+  // contact made since, in any pass, was a live row: the others were too far apart to touch.) Not
+  // while each contact's shear displacement is tracked: every row then goes through force_row.
+  live_now_ = !settings.track_shear_displacement;
   if (!terms_ready || live_rows_of_ != rows || !(live_proximity_ == settings.proximity)) live_ready_ = false;
   if (live_now_ && !(live_ready_ && live_travel_known_ && live_travel_ <= live_slack_)) refresh_live_rows();
   live_travel_known_ = false;  // (measured again before the next pass)
-  // The live rows through their records (use_live_records) on the steps nobody looks at, made when
+  // The live rows through their records on the steps nobody looks at, made when
   // at least kRecordSteps more steps follow in this cycle() call: making them and writing them back
   // cost about half a step at 100,800 spheres (calls of 9 steps gave 1.021 x against 1.084 x for calls
   // of 200), which ≈ 1.08 x a step wins back in about eight steps.
   constexpr std::int64_t kRecordSteps = 8;
-  const bool records = live_now_ && use_live_records && !write_results_;
+  const bool records = live_now_ && !write_results_;
   if (live_records_ready_ && !records) sync_live_records();
   if (records && !live_records_ready_ && steps_ahead_ >= kRecordSteps) build_live_records();
   live_record_passes_ += live_records_ready_;
-  const bool live_split = split_by_live_rows();
   std::unique_ptr<std::atomic<bool>[]> crossing_done;  // per thread: its crossing list is final
-  const bool owner = use_owner_sums;
   std::atomic<bool> late_share{false};
 #pragma omp parallel reduction(min : bad_row) reduction(+ : batched) if (n > kParallelMin)
   {
@@ -1612,9 +1575,8 @@ void Simulation::force_pass(double dt) {
       // the thread count changed, every kSplitEvery passes, or when the threads' speeds moved their
       // shares (balance_speeds, every kSpeedEvery passes).
       const auto threads = static_cast<std::size_t>(omp_get_num_threads());
-      // (use_speed_split turned off: equal shares from this pass on.)
       bool resplit = work_start_.size() != threads + 1 || work_start_.back() != n || split_rows_ != rows ||
-                     thread_share_.size() != threads || (shares_by_speed_ && !use_speed_split) ||
+                     thread_share_.size() != threads ||
                      ++split_age_ >= kSplitEvery;
       if (!resplit && ++speed_age_ >= kSpeedEvery) resplit = balance_speeds();
       if (resplit) {
@@ -1635,19 +1597,15 @@ void Simulation::force_pass(double dt) {
     const std::size_t first = work_start_[t], last = work_start_[t + 1];
     std::vector<CrossShare>& crossing = crossing_[t];
     crossing.clear();
-    // One thread needs no split, nor the counts it is made from (3 % of a step in cache); with the
-    // live rows the split needs no counts either (split_work).
+    // One thread needs no timing: its share is the whole.
     const bool timed = omp_get_num_threads() > 1;
-    const bool count_contacts = timed && !live_split;
     const double busy_from = timed ? omp_get_wtime() : 0.0;
     // The lowest ball of the range with a row into a later range (made once per split: the rows do
     // not change until the next). Below it the thread adds no crossing share, and from there its list
     // is final and announced (crossing_done), long before its pass ends: the blocks run from the
     // last down, and the crossing rows are those of its top layer of balls: only its top row_span_
-    // balls can have one, and the last range has none. (The scan of the whole range from its bottom,
-    // which one thread made on every pass, cost it 1.03-1.05 x at 100,800 spheres; twenty-first
-    // session.)
-    if (owner && crossing_floor_[t] == kFloorUnknown) {
+    // balls can have one, and the last range has none.
+    if (crossing_floor_[t] == kFloorUnknown) {
       std::size_t floor = last;
       if (last < n)
         for (std::size_t a = last - std::min(last - first, row_span_); a < last && floor == last; ++a)
@@ -1662,36 +1620,30 @@ void Simulation::force_pass(double dt) {
       announced = true;
       announced_size = crossing.size();
     };
-    if (owner && floor >= last) announce();
+    if (floor >= last) announce();
     if (last > first)
       for (std::size_t a = first + (last - first - 1) / block * block;; a -= block) {
-        force_block(a, std::min(last, a + block), last, dt, *scratch, crossing, bad_row, batched, count_contacts);
-        if (owner && !announced && a <= floor) announce();
+        force_block(a, std::min(last, a + block), last, dt, *scratch, crossing, bad_row, batched);
+        if (!announced && a <= floor) announce();
         if (a == first) break;
       }
-    if (owner && !announced) announce();
+    if (!announced) announce();
     // (A share added after the list was announced would be a wrong floor: another thread may have read
     // the list already. Never seen; checked, as it costs nothing.)
-    if (owner && crossing.size() != announced_size) late_share.store(true, std::memory_order_relaxed);
+    if (crossing.size() != announced_size) late_share.store(true, std::memory_order_relaxed);
     // The end of the range's force sums, by the thread itself, in their order (force_pass): the
     // crossing shares into its balls from the ranges below, the last range's first (each list once
     // its thread announced it: no wait in practice), then its balls' wall rows in row order
     // (wall_block: each row's result depends on no other row, nor on the batch it falls into).
-    if (owner) {
-      for (std::size_t u = t; u-- > 0;) {
-        for (int spin = 0; !crossing_done[u].load(std::memory_order_acquire); ++spin)
-          if (spin > 1000) std::this_thread::yield();  // (more threads than cores: let the other run)
-        add_crossing(crossing_[u], first, last);
-      }
-      const std::size_t k0 = wall_rows_start_[first], k1 = wall_rows_start_[last];
-      if (k1 > k0) {
-        wall_block(k0, k1, dt, *scratch, bad_row, batched);
-        add_wall_rows(k0, k1);
-      }
-    } else {
-      const auto threads = static_cast<std::size_t>(omp_get_num_threads());
-      const std::size_t k0 = wall_rows_.size() * t / threads, k1 = wall_rows_.size() * (t + 1) / threads;
-      if (k1 > k0) wall_block(k0, k1, dt, *scratch, bad_row, batched);
+    for (std::size_t u = t; u-- > 0;) {
+      for (int spin = 0; !crossing_done[u].load(std::memory_order_acquire); ++spin)
+        if (spin > 1000) std::this_thread::yield();  // (more threads than cores: let the other run)
+      add_crossing(crossing_[u], first, last);
+    }
+    const std::size_t k0 = wall_rows_start_[first], k1 = wall_rows_start_[last];
+    if (k1 > k0) {
+      wall_block(k0, k1, dt, *scratch, bad_row, batched);
+      add_wall_rows(k0, k1);
     }
     if (timed) thread_busy_[t] += omp_get_wtime() - busy_from;  // [s] (balance_speeds)
   }
@@ -1708,7 +1660,7 @@ void Simulation::force_pass(double dt) {
         << " (gap " << contacts.gap[bad_row] << " m): the run is unstable; reduce the time step";
     throw RunError(msg.str());
   }
-  collect_forces(/*ball_ends_added=*/owner);
+  collect_forces();
 }
 
 void Simulation::add_crossing(const std::vector<CrossShare>& list, std::size_t first, std::size_t last) {
@@ -1735,17 +1687,10 @@ void Simulation::add_wall_rows(std::size_t k0, std::size_t k1) {
   }
 }
 
-void Simulation::collect_forces(bool ball_ends_added) {
-  // Unless the threads added them themselves (use_owner_sums), the end of every ball's force sum
-  // (the order of force_pass): the shares of rows whose second ball lay beyond the range of the
-  // thread that ran them, in descending row order (the threads' ranges from the last down, each
-  // thread's list in the order it was made), then each ball's wall rows in row order. Then the
-  // walls' sums. Rows that are not active contacts hold zero force and moment.
+void Simulation::collect_forces() {
+  // The walls' sums, each wall row in row order (the balls' sums were ended by the pass's threads).
+  // Rows that are not active contacts hold zero force and moment.
   const bool want_stiffness = settings.auto_timestep || settings.density_scaling;
-  if (!ball_ends_added) {
-    for (std::size_t t = crossing_.size(); t-- > 0;) add_crossing(crossing_[t], 0, ball_sums_.size());
-    add_wall_rows(0, wall_rows_.size());
-  }
   for (Wall& w : walls.walls) {
     w.force = w.moment = Vec3{};
     w.normal_force = w.normal_stiffness = 0.0;

@@ -111,75 +111,14 @@ class Simulation {
   // make_dry on every hill contact; returns how many were wet.
   std::size_t make_dry();
 
-  // Existing ball-ball contacts go through the batched laws (engine/contact_batch.hpp); false: every
-  // row through the row-by-row laws (the two agree to rounding; kept for tests and comparison).
-  bool use_batched_kernel = true;
-  // The lanes' ball fields from whole ball records transposed in AVX-512 registers (where the build
-  // has AVX-512), and a hill lane's history, parameters and M from its live record likewise, eight
-  // lanes at a time; false: copied lane by lane. The same bits either way (kept for tests).
-  bool use_vector_fill = true;
-  // The common lanes' results added into the balls' sums and written into the live records eight
-  // lanes at a time, transposed in AVX-512 registers (where the build has AVX-512); false: lane by
-  // lane. The same bits either way (kept for tests).
-  bool use_vector_scatter = true;
-  // The record motion measures each ball's travel since the live rows were made only when a bound
-  // carried from step to step (the last measured travel plus each step's largest |V| Δt) comes near
-  // the slack; false: every step. Which steps make the live rows again may change, the results not
-  // (the live rows change no result).
-  bool use_live_bound = true;
-  // Hill rows (contacts and neighbour pairs alike) through the force pass's row loop without a branch
-  // on whether the row is a contact (force_block), when there are more than branchless_rows_min rows;
-  // false, or fewer rows: with that branch. The same bits either way. Below ≈ 15,000 rows the branch
-  // predictor learns which rows are contacts (the pattern repeats every step) and the branch is the
-  // faster way (0.94-0.96 x without it, 3,713 spheres); at 11,200 spheres (≈ 47,000 rows) it no longer
-  // does, and the loop without the branch is 1.14 x faster (docs/performance.md, thirteenth session).
-  bool use_branchless_rows = true;
-  std::size_t branchless_rows_min = std::size_t{1} << 15;
-  // The row loop visits only the live rows: the contacts, the rows of other models than hill, and
-  // the hill neighbour pairs within proximity + 2 s, when the list was made. The list is made again
-  // when any ball has moved more than s since (the slack s adapts to how fast the balls move,
-  // refresh_live_rows), so a pair not on it cannot have come within reach, and gives nothing: the
-  // sums and their order are those of all rows, the same bits either way (test
-  // HillBatch.LiveRowsOrAllRowsGiveTheSameBits). In the settled bench bed ≈ 40 % of the rows are not
-  // on it, and the loop skips them (docs/performance.md, fourteenth and twenty-first sessions).
-  bool use_live_rows = true;
-  // How often the live rows were made.
+  // How often the live rows were made (the rows the force pass visits: contacts, rows of other models
+  // than hill, and the hill neighbour pairs within proximity + 2 s when the list was made; remade when
+  // a ball has moved more than the slack s since).
   std::int64_t live_row_refreshes() const { return live_refreshes_; }
-  // Within a cycle() or solve() call, the law of motion moves the balls' records (the position,
-  // velocity and spin the force pass reads) and measures how far each ball travelled since the
-  // neighbour list and the live rows were made, in one pass; the BallStore's columns are written too
-  // only on the steps someone may look at (the last, and every step while an observer or controller
-  // is registered). false: the columns are moved (advance_balls), the travel is measured in a second
-  // pass, and the force pass copies the columns into the records, three passes over the balls. The
-  // same bits either way (one law, motion/ball_step.hpp; test
-  // Motion.RecordsOrColumnsGiveTheSameBits): 1.04 x at 100,800 spheres, 1.02-1.03 x at 11,200 and in
-  // cache (docs/performance.md, fifteenth session).
-  bool use_record_motion = true;
-  // Threads share the balls of the force pass in proportion to their measured speeds (the cores of a
-  // shared machine do not run equally fast); false: equal work. Results do not depend on the shares.
-  bool use_speed_split = true;
-  // Each thread of the force pass ends its own balls' force sums. It adds the shares from rows that
-  // crossed into them from the ranges below. Each range's list is added as soon as its thread has
-  // passed its top layer of balls, which is early, since the blocks run from the top down. Then it
-  // runs its balls' wall rows and adds them.
-  // false: one thread adds all of it after the pass while the others wait, and the wall rows are
-  // shared out by count. The same bits either way. Median 1.02 x on two threads at 100,800 spheres
-  // (twelve --alternate runs, 0.96-1.04 x; docs/performance.md, twentieth session).
-  bool use_owner_sums = true;
-  // Within a cycle() call, on the steps nobody looks at, the row loop reads and writes each live row
-  // through a record of one cache line in live-row order (its second ball, image, flags, parameter
-  // set, n̂_c and F^h_s) instead of through the row columns: one memory stream a row instead of nine.
-  // The records hold the live hill rows' history until they are written back into the columns
-  // (sync_live_records): before any step someone looks at, at the end of every cycle() call, before a
-  // rebuild or a new live list, and when a step throws, so the columns are current wherever anyone
-  // outside the force pass reads them. The same
-  // bits either way (test HillBatch.LiveRecordsOrColumnsGiveTheSameBits): 1.07-1.08 x at 100,800
-  // spheres, 1.03-1.05 x at 11,200 (docs/performance.md, eighteenth session).
-  bool use_live_records = true;
   // How many force passes ran through the live records.
   std::int64_t live_record_passes() const { return live_record_passes_; }
-  // Given shares of the work per thread (one per thread, normalised) instead: for tests, and for cores
-  // of known speeds. Empty: measured (use_speed_split) or equal.
+  // Given shares of the work per thread (one per thread, normalised) instead of those measured from
+  // the threads' speeds: for tests, and for cores of known speeds. Results do not depend on them.
   std::vector<double> thread_shares;
   // Balls per block of the force pass (a block's contacts fill the batches together; blocks are
   // the unit of work of the threads). A tuning knob only: results do not depend on it (the batches
@@ -233,7 +172,7 @@ class Simulation {
   void build_row_lists();  // per-ball row lists (CSR) and wall rows from the current rows
   void rebuild_if_needed();
   void force_pass(double dt);
-  // The law of motion on the records (use_record_motion), with each ball's travel since the
+  // The law of motion on the records, with each ball's travel since the
   // neighbour list (and since the live rows) measured as it moves; write_columns: the BallStore's
   // columns too.
   void advance_records(double dt, const double* inertial_mass, const double* inertial_inertia, bool write_columns);
@@ -314,18 +253,15 @@ class Simulation {
   // The rows of balls a0..a1-1 (ball-ball), summed into both balls (see force_pass for the order);
   // a second ball at or beyond range_end (outside this thread's range) gets its share in `crossing`.
   // bad_row: the lowest row with a non-finite force; batched: + the rows that went through a batch.
-  // count_contacts: also count each ball's contacts for the next pass's split_work.
   void force_block(std::size_t a0, std::size_t a1, std::size_t range_end, double dt, BlockScratch& scratch,
-                   std::vector<CrossShare>& crossing, std::size_t& bad_row, std::int64_t& batched,
-                   bool count_contacts);
+                   std::vector<CrossShare>& crossing, std::size_t& bad_row, std::int64_t& batched);
   // The wall rows wall_rows_[k0..k1): existing linear contacts that touch their wall through a linear
   // batch (the wall's geometry given), the rest row by row (force_row). Each row's results go to its
   // columns and share_moment_; collect_forces() sums them in row order, so the batches need no order.
   void wall_block(std::size_t k0, std::size_t k1, double dt, BlockScratch& scratch, std::size_t& bad_row,
                   std::int64_t& batched);
-  // The walls' sums; and, unless the pass's threads added them (use_owner_sums), the end of the balls'
-  // force sums (the crossing shares, then each ball's wall rows).
-  void collect_forces(bool ball_ends_added);
+  // The walls' sums (the balls' sums were ended by the pass's threads: force_pass).
+  void collect_forces();
   // The shares of `list` into balls first..last-1, in list order; the wall rows wall_rows_[k0..k1)
   // into their balls, in row order (both with their stiffness terms when those are summed).
   void add_crossing(const std::vector<CrossShare>& list, std::size_t first, std::size_t last);
@@ -356,8 +292,8 @@ class Simulation {
   // (rows first_rows_[a]..[a+1]: keys are sorted by kind, then a, then b > a) from the last down,
   // and adds each row's share to a and to b: b's own rows came before (b > a), and every row (x, b)
   // with x < a comes after. A row whose b lies beyond the thread's range leaves b's share in
-  // crossing_, added in descending row order once the thread's own rows are done (by b's thread,
-  // use_owner_sums; or after the pass): those rows (x below the range of b's thread) come last in b's
+  // crossing_, added in descending row order once the thread's own rows are done (by b's thread):
+  // those rows (x below the range of b's thread) come last in b's
   // order. Then the wall rows, from F_c and share_moment_.
   std::vector<std::uint32_t> first_rows_;
   // Per ball, the ball-ball rows where it is piece 2 (in row order; the same sums from the rows
@@ -416,22 +352,17 @@ class Simulation {
   bool applied_known_ = false, applied_zero_ = false;
   bool skin_known_ = false;
   double skin_ = 0.0;  // [m] skin() while skin_known_
-  // Per ball, its rows that were contacts in the last pass with more than one thread and without
-  // the live rows (split_work).
-  std::vector<std::uint32_t> ball_contacts_;
-  bool split_by_live_rows() const;  // split_work weighs the balls by their live rows
   std::vector<std::size_t> work_start_;        // threads' ranges of balls in the force pass (split_work)
   std::vector<std::uint64_t> work_prefix_;     // split_work's running sum of work per ball
   std::size_t split_rows_ = 0;                 // rows when the split was made
   int split_age_ = 0;                          // force passes since
   static constexpr int kSplitEvery = 50;
   // Threads' shares of the work (split_work), and their time in the blocks since the split [s]
-  // (use_speed_split, balance_speeds, looked at every kSpeedEvery passes).
+  // (balance_speeds, looked at every kSpeedEvery passes).
   std::vector<double> thread_share_;
   std::vector<double> thread_busy_;
   static constexpr int kSpeedEvery = 10;
   int speed_age_ = 0;  // force passes since the speeds were measured afresh
-  bool shares_by_speed_ = false;  // the split's shares came from the speeds
   bool balance_speeds();  // true: the shares moved, split again
   bool body_terms_ready_ = false;            // ball_kin_[i].terms are up to date (see force_pass)
   // The hill parameters the batched pass reads, by set: row c's are hill_sets_[row_hill_set_[c]], the
@@ -446,7 +377,7 @@ class Simulation {
   bool hill_sets_stale_ = true;  // (set by create_contact from the pass's threads: std::atomic_ref)
   void refresh_param_sets();
   std::vector<double> scaled_mass_, scaled_inertia_;  // density scaling [kg], [kg m²]
-  // The live rows (use_live_rows): per ball (live_first_, as first_rows_), in row order, its
+  // The live rows: per ball (live_first_, as first_rows_), in row order, its
   // ball-ball rows that were live when the list was made (refresh_live_rows), at the positions
   // position_at_live_ [m]: contacts, rows of other models, and hill neighbour pairs within
   // proximity + 2 live_slack_ [m]. While no ball has moved more than live_slack_ since, a pair not on
@@ -465,12 +396,12 @@ class Simulation {
   // (valid while live_bound_valid_): exact where it was last measured ball by ball (rebuild_if_needed,
   // advance_records), then grown by each record motion by its largest |V| Δt (live_growth_, the last
   // step's), as travel_bound_ is. advance_records measures ball by ball only when the bound, grown by
-  // a few more such steps, would pass the slack (use_live_bound).
+  // a few more such steps, would pass the slack.
   double live_travel_ = 0.0, live_growth_ = 0.0;
   bool live_bound_valid_ = false;
   bool live_travel_known_ = false; // measured for this pass
   void refresh_live_rows();
-  // The live rows' records (use_live_records), in live-row order (live_rows_), one cache line each:
+  // The live rows' records, in live-row order (live_rows_), one cache line each:
   // what the row loop and the lanes read and write of a row. n̂_c, F^h_s and M are those of hill rows
   // only (other models keep theirs in the columns, and their `exists` is read there too).
   struct alignas(64) LiveRecord {
