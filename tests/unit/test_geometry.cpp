@@ -7,7 +7,7 @@
 #include <random>
 
 #include "hilldem/bodies/wall_store.hpp"
-#include "hilldem/contact/contact_kinematics.hpp"
+#include "hilldem/models/contact_kinematics.hpp"
 
 namespace hilldem {
 namespace {

@@ -15,11 +15,13 @@
 //   R_o = min(R1, R2) = 5e-3 m
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
 
 #include "hilldem/models/hill.hpp"
+#include "hilldem/models/lanes.hpp"
 
 namespace hilldem {
 namespace {
@@ -62,6 +64,57 @@ HillState state(const Vec3& shear_hm, Moisture m = Moisture::Dry) {
   s.shear_hm = shear_hm;
   s.moisture = m;
   return s;
+}
+
+// The production law at both of its widths: hill_law<lanes::Pack>, as the batched force pass runs it,
+// with the contact in every lane of a Pack (lane j at the gap g_c + j·1e-6 m), and hill_force, its
+// one-contact form (hill_law<double>), at each lane's gap. The two agree to rounding (the compiler
+// may fuse other multiply-adds in vector code) and in every flag. Returns lane 0 (the gap g_c) as a
+// HillResult: every hand value below is checked on the batched width, and the one-contact form
+// within rounding of it.
+HillResult hill_force_both_widths(const HillParams& p, const HillMapping& m, const ContactKinematics& k,
+                                  const HillState& previous) {
+  using lanes::Pack;
+  auto pack3 = [](const Vec3& v) { return lanes::V3<Pack>{lanes::splat<Pack>(v.x), lanes::splat<Pack>(v.y), lanes::splat<Pack>(v.z)}; };
+  Pack gaps;
+  for (std::size_t j = 0; j < lanes::kWidth; ++j) gaps[j] = k.gap + static_cast<double>(j) * 1e-6;
+  const Vec3 shear_rate = k.shear_rate();
+  const bool wet = previous.moisture == Moisture::Wet;
+  const HillOutput<Pack> o = hill_law<Pack>(
+      {lanes::splat<Pack>(p.fric_coef), lanes::splat<Pack>(p.suction), lanes::splat<Pack>(m.kn), lanes::splat<Pack>(m.ks),
+       lanes::splat<Pack>(m.bn), lanes::splat<Pack>(m.bs), lanes::splat<Pack>(m.r_o), pack3(k.normal), gaps,
+       lanes::splat<Pack>(k.normal_rate()), pack3(shear_rate), k.dt, pack3(previous.shear_hm),
+       wet ? ~lanes::PackMask{} : lanes::PackMask{}});
+  auto lane = [&o, &previous](std::size_t j) {
+    HillResult r;
+    r.surface_normal = o.surface_normal[j];
+    r.moisture_force = o.moisture_force[j];
+    r.trial_shear = o.trial_shear[j];
+    r.shear_force = {o.shear_force.x[j], o.shear_force.y[j], o.shear_force.z[j]};
+    r.force = {o.force.x[j], o.force.y[j], o.force.z[j]};
+    r.active = o.active[j] != 0;
+    r.state = {{o.shear_hm.x[j], o.shear_hm.y[j], o.shear_hm.z[j]},
+               o.ruptured[j] != 0 ? Moisture::Ruptured : previous.moisture};
+    return r;
+  };
+  // (Within 1e-13 relative, or 1e-9 N where a component is a near-cancellation of two terms.)
+  auto near = [](double a, double b) { return std::abs(a - b) <= 1e-13 * std::max(std::abs(a), std::abs(b)) + 1e-9; };
+  for (std::size_t j = 0; j < lanes::kWidth; ++j) {
+    ContactKinematics kj = k;
+    kj.gap = gaps[j];
+    const HillResult r = hill_force(p, m, kj, previous), v = lane(j);
+    EXPECT_TRUE(near(v.surface_normal, r.surface_normal)) << j << ": " << v.surface_normal << " " << r.surface_normal;
+    EXPECT_TRUE(near(v.moisture_force, r.moisture_force)) << j;
+    EXPECT_TRUE(near(v.trial_shear, r.trial_shear)) << j;
+    for (int d = 0; d < 3; ++d) {
+      EXPECT_TRUE(near(v.force[d], r.force[d])) << j << " " << d;
+      EXPECT_TRUE(near(v.shear_force[d], r.shear_force[d])) << j << " " << d;
+      EXPECT_TRUE(near(v.state.shear_hm[d], r.state.shear_hm[d])) << j << " " << d;
+    }
+    EXPECT_EQ(v.active, r.active) << j;
+    EXPECT_EQ(v.state.moisture, r.state.moisture) << j;
+  }
+  return lane(0);
 }
 
 void expect_vec_near(const Vec3& a, const Vec3& b, double tol) {
@@ -135,7 +188,7 @@ TEST(HillActive, WetOrOverlapping) {
 // H4: F_n = k_n δ^1.5 = 1.083305e9 · (1e-4)^1.5 = 1.083305e9 · 1e-6 = 1083.305 N
 TEST(HillNormal, HertzAtTenthOfAMillimetre) {
   const HillMapping m = hill_mapping(params(0.4, 0.0), granite());
-  const HillResult r = hill_force(params(0.4, 0.0), m, kin(kZ, -1e-4, {}), HillState{});
+  const HillResult r = hill_force_both_widths(params(0.4, 0.0), m, kin(kZ, -1e-4, {}), HillState{});
   EXPECT_TRUE(r.active);
   EXPECT_NEAR(r.surface_normal, 1083.305, rel7(1083.305));
   EXPECT_EQ(r.moisture_force, 0.0);
@@ -147,14 +200,14 @@ TEST(HillNormal, HertzAtTenthOfAMillimetre) {
 TEST(HillNormal, ForceAlongAnObliqueNormal) {
   const Vec3 n{1.0 / 3.0, 2.0 / 3.0, 2.0 / 3.0};
   const HillMapping m = hill_mapping(params(0.4, 0.0), granite());
-  const HillResult r = hill_force(params(0.4, 0.0), m, kin(n, -1e-4, {}), HillState{});
+  const HillResult r = hill_force_both_widths(params(0.4, 0.0), m, kin(n, -1e-4, {}), HillState{});
   expect_vec_near(r.force, n * 1083.305, rel7(1083.305));
 }
 
 TEST(HillNormal, DampingDoesNotChangeTheStaticForce) {
   // With no relative velocity the dashpot adds nothing (D3 and H4 both at rest).
   const HillMapping m = hill_mapping(params(0.4, 0.07), granite());
-  const HillResult r = hill_force(params(0.4, 0.07), m, kin(kZ, -1e-4, {}), HillState{});
+  const HillResult r = hill_force_both_widths(params(0.4, 0.07), m, kin(kZ, -1e-4, {}), HillState{});
   EXPECT_NEAR(r.surface_normal, 1083.305, rel7(1083.305));
 }
 
@@ -165,7 +218,7 @@ TEST(HillNormal, DampingDoesNotChangeTheStaticForce) {
 TEST(HillNormal, DashpotWhileClosingD2) {
   const HillMapping m = hill_mapping(params(0.4, 0.07), granite());
   // δ̇ = v2 − v1 = −100 n̂: piece 2 moves towards piece 1.
-  const HillResult r = hill_force(params(0.4, 0.07), m, kin(kZ, -2e-4, {0, 0, -100.0}), HillState{});
+  const HillResult r = hill_force_both_widths(params(0.4, 0.07), m, kin(kZ, -2e-4, {0, 0, -100.0}), HillState{});
   EXPECT_NEAR(r.surface_normal, 3960.446, rel7(3960.446));
   expect_vec_near(r.force, {0, 0, 3960.446}, rel7(3960.446));
 }
@@ -173,21 +226,21 @@ TEST(HillNormal, DashpotWhileClosingD2) {
 // D3: the same overlap after the velocity is reset to zero: Hertz part only, 3064.048 N.
 TEST(HillNormal, AfterVelocityResetD3) {
   const HillMapping m = hill_mapping(params(0.4, 0.07), granite());
-  const HillResult r = hill_force(params(0.4, 0.07), m, kin(kZ, -2e-4, {}), HillState{});
+  const HillResult r = hill_force_both_widths(params(0.4, 0.07), m, kin(kZ, -2e-4, {}), HillState{});
   EXPECT_NEAR(r.surface_normal, 3064.048, rel7(3064.048));
 }
 
 TEST(HillNormal, DashpotOpposesSeparation) {
   // Separating at 100 m/s: 3064.048 − 896.398 = 2167.650 N.
   const HillMapping m = hill_mapping(params(0.4, 0.07), granite());
-  const HillResult r = hill_force(params(0.4, 0.07), m, kin(kZ, -2e-4, {0, 0, 100.0}), HillState{});
+  const HillResult r = hill_force_both_widths(params(0.4, 0.07), m, kin(kZ, -2e-4, {0, 0, 100.0}), HillState{});
   EXPECT_NEAR(r.surface_normal, 2167.650, 2e-3);
 }
 
 TEST(HillNormal, TouchingExactlyGivesNoForce) {
   const HillMapping m = hill_mapping(params(0.4, 0.07), granite());
   const HillResult r =
-      hill_force(params(0.4, 0.07), m, kin(kZ, 0.0, {3.0, 0.0, -5.0}), state({-100.0, 0, 0}));
+      hill_force_both_widths(params(0.4, 0.07), m, kin(kZ, 0.0, {3.0, 0.0, -5.0}), state({-100.0, 0, 0}));
   EXPECT_TRUE(r.active);  // g_c ≤ 0
   EXPECT_EQ(r.surface_normal, 0.0);
   expect_vec_near(r.force, {}, 0.0);
@@ -202,7 +255,7 @@ TEST(HillNormal, TouchingExactlyGivesNoForce) {
 TEST(HillShear, HertzMindlinIncrementH7) {
   const HillParams p = params(1000.0, 0.0);
   const HillMapping m = hill_mapping(p, granite());
-  const HillResult r = hill_force(p, m, kin(kZ, -1e-4, {99.0, 0, 0}), HillState{});
+  const HillResult r = hill_force_both_widths(p, m, kin(kZ, -1e-4, {99.0, 0, 0}), HillState{});
   expect_vec_near(r.shear_force, {-1478.272, 0, 0}, rel7(1478.272));
   expect_vec_near(r.state.shear_hm, {-1478.272, 0, 0}, rel7(1478.272));
   EXPECT_NEAR(r.trial_shear, 1478.272, rel7(1478.272));
@@ -217,17 +270,17 @@ TEST(HillShear, HertzMindlinIncrementH7) {
 TEST(HillShear, DashpotStepD6D7) {
   const HillParams p0 = params(1000.0, 0.0);
   const HillMapping m0 = hill_mapping(p0, granite());
-  const HillResult stage_b = hill_force(p0, m0, kin(kZ, -1e-4, {99.0, 0, 0}), HillState{});
+  const HillResult stage_b = hill_force_both_widths(p0, m0, kin(kZ, -1e-4, {99.0, 0, 0}), HillState{});
 
   const HillParams p = params(1000.0, 0.07);
   const HillMapping m = hill_mapping(p, granite());
-  const HillResult r = hill_force(p, m, kin(kZ, -1e-4, {4.95, 0, 0}), stage_b.state);
+  const HillResult r = hill_force_both_widths(p, m, kin(kZ, -1e-4, {4.95, 0, 0}), stage_b.state);
   expect_vec_near(r.shear_force, {-1595.991, 0, 0}, rel7(1595.991));
   expect_vec_near(r.state.shear_hm, {-1552.185, 0, 0}, rel7(1552.185));
   EXPECT_NEAR(r.trial_shear, 1595.991, rel7(1595.991));
 
   // The rotation stops: the dashpot part disappears and only the stored part remains (D7).
-  const HillResult after = hill_force(p, m, kin(kZ, -1e-4, {}), r.state);
+  const HillResult after = hill_force_both_widths(p, m, kin(kZ, -1e-4, {}), r.state);
   expect_vec_near(after.shear_force, {-1552.185, 0, 0}, rel7(1552.185));
   expect_vec_near(after.state.shear_hm, {-1552.185, 0, 0}, rel7(1552.185));
 }
@@ -235,7 +288,7 @@ TEST(HillShear, DashpotStepD6D7) {
 TEST(HillShear, NormalVelocityDoesNotEnterTheShear) {
   const HillParams p = params(1000.0, 0.07);
   const HillMapping m = hill_mapping(p, granite());
-  const HillResult r = hill_force(p, m, kin(kZ, -1e-4, {0, 0, -30.0}), state({0, -500.0, 0}));
+  const HillResult r = hill_force_both_widths(p, m, kin(kZ, -1e-4, {0, 0, -30.0}), state({0, -500.0, 0}));
   expect_vec_near(r.shear_force, {0, -500.0, 0}, 1e-9);
   expect_vec_near(r.state.shear_hm, {0, -500.0, 0}, 1e-9);
 }
@@ -245,7 +298,7 @@ TEST(HillShear, NormalVelocityDoesNotEnterTheShear) {
 TEST(HillShear, CoulombClampEq16) {
   const HillParams p = params(0.4, 0.0);
   const HillMapping m = hill_mapping(p, granite());
-  const HillResult r = hill_force(p, m, kin(kZ, -1e-4, {99.0, 0, 0}), HillState{});
+  const HillResult r = hill_force_both_widths(p, m, kin(kZ, -1e-4, {99.0, 0, 0}), HillState{});
   EXPECT_NEAR(r.trial_shear, 1478.272, rel7(1478.272));
   expect_vec_near(r.state.shear_hm, {-433.3219, 0, 0}, rel7(433.3219));
   expect_vec_near(r.shear_force, {-433.3219, 0, 0}, rel7(433.3219));
@@ -259,7 +312,7 @@ TEST(HillShear, CoulombClampEq16) {
 TEST(HillShear, CoulombClampEq18OnTheTotal) {
   const HillParams p = params(0.4, 0.07);
   const HillMapping m = hill_mapping(p, granite());
-  const HillResult r = hill_force(p, m, kin(kZ, -1e-4, {20.0, 0, 0}), HillState{});
+  const HillResult r = hill_force_both_widths(p, m, kin(kZ, -1e-4, {20.0, 0, 0}), HillState{});
   expect_vec_near(r.state.shear_hm, {-298.6407, 0, 0}, rel7(298.6407));
   EXPECT_NEAR(r.trial_shear, 475.6344, rel7(475.6344));
   expect_vec_near(r.shear_force, {-433.3219, 0, 0}, rel7(433.3219));
@@ -269,7 +322,7 @@ TEST(HillShear, ClampKeepsTheDirectionOfTheTrial) {
   const HillParams p = params(0.4, 0.0);
   const HillMapping m = hill_mapping(p, granite());
   // Stored shear along +y, increment along −x: the trial is (+1478.272, +1000, 0).
-  const HillResult r = hill_force(p, m, kin(kZ, -1e-4, {-99.0, 0, 0}), state({0, 1000.0, 0}));
+  const HillResult r = hill_force_both_widths(p, m, kin(kZ, -1e-4, {-99.0, 0, 0}), state({0, 1000.0, 0}));
   const double trial = std::hypot(1478.272, 1000.0);
   EXPECT_NEAR(r.trial_shear, trial, rel7(trial));
   const Vec3 expected = Vec3{1478.272, 1000.0, 0} * (433.3219 / trial);
@@ -289,7 +342,7 @@ TEST(HillShear, SlipEnvelope) {
     s = (s - n * dot(s, n)) * 2000.0;  // stored shear, in the plane
     const double gap = -3e-4 * (u(rng) + 1.0) / 2.0;
     const Moisture mo = t % 2 ? Moisture::Wet : Moisture::Dry;
-    const HillResult r = hill_force(p, m, kin(n, gap, v), state(s, mo));
+    const HillResult r = hill_force_both_widths(p, m, kin(n, gap, v), state(s, mo));
     const double limit = std::max(0.0, p.fric_coef * r.surface_normal);
     EXPECT_LE(norm(r.shear_force), limit * (1 + 1e-12) + 1e-12);
     EXPECT_LE(norm(r.state.shear_hm), limit * (1 + 1e-12) + 1e-12);
@@ -303,7 +356,7 @@ TEST(HillShear, SlipEnvelope) {
 TEST(HillShear, NegativeSurfaceForceGivesZeroShear) {
   const HillParams p = params(0.4, 0.07);
   const HillMapping m = hill_mapping(p, granite());
-  const HillResult r = hill_force(p, m, kin(kZ, -1e-4, {10.0, 0, 200.0}), state({-300.0, 0, 0}));
+  const HillResult r = hill_force_both_widths(p, m, kin(kZ, -1e-4, {10.0, 0, 200.0}), state({-300.0, 0, 0}));
   EXPECT_NEAR(r.surface_normal, -424.251, 1e-3);
   EXPECT_GT(r.trial_shear, 0.0);
   EXPECT_EQ(norm(r.shear_force), 0.0);
@@ -318,7 +371,7 @@ TEST(HillShear, NegativeSurfaceForceGivesZeroShear) {
 TEST(HillInactive, DryOpenContactGivesExactlyZero) {
   const HillParams p = params(0.4, 0.07, 200e3);
   const HillMapping m = hill_mapping(p, granite());
-  const HillResult r = hill_force(p, m, kin(kZ, 1e-4, {3.0, -2.0, -50.0}), state({-300.0, 40.0, 0}));
+  const HillResult r = hill_force_both_widths(p, m, kin(kZ, 1e-4, {3.0, -2.0, -50.0}), state({-300.0, 40.0, 0}));
   EXPECT_FALSE(r.active);
   EXPECT_EQ(r.surface_normal, 0.0);
   EXPECT_EQ(r.moisture_force, 0.0);
@@ -331,7 +384,7 @@ TEST(HillInactive, DryOpenContactGivesExactlyZero) {
 TEST(HillInactive, RupturedOpenContactStaysRupturedAndGivesZero) {
   const HillParams p = params(0.4, 0.07, 200e3);
   const HillMapping m = hill_mapping(p, granite());
-  const HillResult r = hill_force(p, m, kin(kZ, 2e-3, {0, 0, -1.0}), state({10.0, 0, 0}, Moisture::Ruptured));
+  const HillResult r = hill_force_both_widths(p, m, kin(kZ, 2e-3, {0, 0, -1.0}), state({10.0, 0, 0}, Moisture::Ruptured));
   EXPECT_FALSE(r.active);
   EXPECT_TRUE(r.force == Vec3{});
   EXPECT_TRUE(r.state.shear_hm == Vec3{});
@@ -363,7 +416,7 @@ TEST(HillMoisture, ZeroAtAndBeyondRupture) {
 TEST(HillMoisture, WetOpenContactAttracts) {
   const HillParams p = params(0.4, 0.07, 200e3);
   const HillMapping m = hill_mapping(p, granite());
-  const HillResult r = hill_force(p, m, kin(kZ, 2e-3, {1.0, 0, 0.5}), state({5.0, 0, 0}, Moisture::Wet));
+  const HillResult r = hill_force_both_widths(p, m, kin(kZ, 2e-3, {1.0, 0, 0.5}), state({5.0, 0, 0}, Moisture::Wet));
   EXPECT_TRUE(r.active);
   EXPECT_EQ(r.state.moisture, Moisture::Wet);
   EXPECT_NEAR(r.moisture_force, -12.86059, rel7(12.86059));
@@ -377,7 +430,7 @@ TEST(HillMoisture, WetOpenContactAttracts) {
 TEST(HillMoisture, WetOverlappingContactAddsSuctionToHertz) {
   const HillParams p = params(0.4, 0.0, 200e3);
   const HillMapping m = hill_mapping(p, granite());
-  const HillResult r = hill_force(p, m, kin(kZ, -1e-4, {}), state({}, Moisture::Wet));
+  const HillResult r = hill_force_both_widths(p, m, kin(kZ, -1e-4, {}), state({}, Moisture::Wet));
   EXPECT_NEAR(r.moisture_force, -15.70796, rel7(15.70796));
   EXPECT_NEAR(r.surface_normal, 1083.305, rel7(1083.305));
   // 1083.305 − 15.70796 = 1067.597 N
@@ -387,7 +440,7 @@ TEST(HillMoisture, WetOverlappingContactAddsSuctionToHertz) {
 TEST(HillMoisture, DryContactHasNoMoistureForce) {
   const HillParams p = params(0.4, 0.0, 200e3);
   const HillMapping m = hill_mapping(p, granite());
-  const HillResult r = hill_force(p, m, kin(kZ, -1e-4, {}), HillState{});
+  const HillResult r = hill_force_both_widths(p, m, kin(kZ, -1e-4, {}), HillState{});
   EXPECT_EQ(r.moisture_force, 0.0);
 }
 
@@ -395,14 +448,14 @@ TEST(HillMoisture, RuptureAtCriticalGap) {
   const HillParams p = params(0.4, 0.07, 200e3);
   const HillMapping m = hill_mapping(p, granite());
   for (double gap : {10e-3, 12e-3}) {
-    const HillResult r = hill_force(p, m, kin(kZ, gap, {0, 0, 1.0}), state({}, Moisture::Wet));
+    const HillResult r = hill_force_both_widths(p, m, kin(kZ, gap, {0, 0, 1.0}), state({}, Moisture::Wet));
     EXPECT_EQ(r.state.moisture, Moisture::Ruptured) << gap;
     EXPECT_FALSE(r.active) << gap;
     EXPECT_EQ(r.moisture_force, 0.0) << gap;
     EXPECT_TRUE(r.force == Vec3{}) << gap;
   }
   // Just inside the rupture gap the bridge holds.
-  const HillResult held = hill_force(p, m, kin(kZ, 9.999e-3, {}), state({}, Moisture::Wet));
+  const HillResult held = hill_force_both_widths(p, m, kin(kZ, 9.999e-3, {}), state({}, Moisture::Wet));
   EXPECT_EQ(held.state.moisture, Moisture::Wet);
   EXPECT_TRUE(held.active);
   EXPECT_NEAR(held.moisture_force, -5.779215, rel7(5.779215));
@@ -415,9 +468,9 @@ TEST(HillMoisture, RuptureAtCriticalGap) {
 TEST(HillAppendixA, DoublingTheOverlapKeepsTheShearForce) {
   const HillParams p = params(1000.0, 0.0);
   const HillMapping m = hill_mapping(p, granite());
-  const HillResult a = hill_force(p, m, kin(kZ, -1e-4, {99.0, 0, 0}), HillState{});
+  const HillResult a = hill_force_both_widths(p, m, kin(kZ, -1e-4, {99.0, 0, 0}), HillState{});
   ASSERT_NEAR(norm(a.state.shear_hm), 1478.272, rel7(1478.272));
-  const HillResult b = hill_force(p, m, kin(kZ, -2e-4, {}), a.state);
+  const HillResult b = hill_force_both_widths(p, m, kin(kZ, -2e-4, {}), a.state);
   EXPECT_NEAR(b.surface_normal, 3064.048, rel7(3064.048));
   expect_vec_near(b.state.shear_hm, {-1478.272, 0, 0}, rel7(1478.272));
   expect_vec_near(b.shear_force, {-1478.272, 0, 0}, rel7(1478.272));
@@ -473,8 +526,8 @@ TEST(HillSymmetry, SwappingPiecesReversesTheForce) {
   const Vec3 v{3.0, -1.0, 2.0};
   for (double gap : {-1e-4, -2e-4, 3e-3}) {
     for (Moisture mo : {Moisture::Dry, Moisture::Wet}) {
-      const HillResult a = hill_force(p, m, kin(n, gap, v), state(stored, mo));
-      const HillResult b = hill_force(p, m, kin(-n, gap, -v), state(-stored, mo));
+      const HillResult a = hill_force_both_widths(p, m, kin(n, gap, v), state(stored, mo));
+      const HillResult b = hill_force_both_widths(p, m, kin(-n, gap, -v), state(-stored, mo));
       expect_vec_near(b.force, -a.force, 1e-9 * (1.0 + norm(a.force)));
       expect_vec_near(b.state.shear_hm, -a.state.shear_hm, 1e-9 * (1.0 + norm(a.state.shear_hm)));
       EXPECT_DOUBLE_EQ(b.surface_normal, a.surface_normal);

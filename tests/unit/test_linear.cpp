@@ -8,9 +8,11 @@
 //   clamp μ F_n = 0.4 · 18221.24 = 7288.495 N                                               (L5)
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
+#include "hilldem/models/lanes.hpp"
 #include "hilldem/models/linear.hpp"
 
 namespace hilldem {
@@ -39,6 +41,44 @@ LinearState state(const Vec3& shear) {
   LinearState s;
   s.shear_force = shear;
   return s;
+}
+
+// The production law at both of its widths (as test_hill.cpp): linear_law<lanes::Pack>, lane j at
+// the gap g_c + j·1e-6 m, against linear_force (linear_law<double>) at each lane's gap, to rounding;
+// returns lane 0.
+LinearResult linear_force_both_widths(const LinearParams& p, const LinearMapping& m, const ContactKinematics& k,
+                                      const LinearState& previous) {
+  using lanes::Pack;
+  auto pack3 = [](const Vec3& v) { return lanes::V3<Pack>{lanes::splat<Pack>(v.x), lanes::splat<Pack>(v.y), lanes::splat<Pack>(v.z)}; };
+  Pack gaps;
+  for (std::size_t j = 0; j < lanes::kWidth; ++j) gaps[j] = k.gap + static_cast<double>(j) * 1e-6;
+  const LinearOutput<Pack> o =
+      linear_law<Pack>({lanes::splat<Pack>(m.kn), lanes::splat<Pack>(m.ks), lanes::splat<Pack>(p.fric), pack3(k.normal),
+                        gaps, pack3(k.shear_rate()), k.dt, pack3(previous.shear_force)});
+  auto lane = [&o](std::size_t j) {
+    LinearResult r;
+    r.normal_force = o.normal_force[j];
+    r.trial_shear = o.trial_shear[j];
+    r.shear_force = {o.shear_force.x[j], o.shear_force.y[j], o.shear_force.z[j]};
+    r.force = {o.force.x[j], o.force.y[j], o.force.z[j]};
+    r.active = o.active[j] != 0;
+    r.state.shear_force = r.shear_force;
+    return r;
+  };
+  auto near = [](double a, double b) { return std::abs(a - b) <= 1e-13 * std::max(std::abs(a), std::abs(b)) + 1e-9; };
+  for (std::size_t j = 0; j < lanes::kWidth; ++j) {
+    ContactKinematics kj = k;
+    kj.gap = gaps[j];
+    const LinearResult r = linear_force(p, m, kj, previous), v = lane(j);
+    EXPECT_TRUE(near(v.normal_force, r.normal_force)) << j;
+    EXPECT_TRUE(near(v.trial_shear, r.trial_shear)) << j;
+    for (int d = 0; d < 3; ++d) {
+      EXPECT_TRUE(near(v.force[d], r.force[d])) << j << " " << d;
+      EXPECT_TRUE(near(v.shear_force[d], r.shear_force[d])) << j << " " << d;
+    }
+    EXPECT_EQ(v.active, r.active) << j;
+  }
+  return lane(0);
 }
 
 void expect_vec_near(const Vec3& a, const Vec3& b, double tol) {
@@ -75,7 +115,7 @@ TEST(LinearMapping, BallWallUsesTheBallRadius) {
 TEST(LinearForce, NormalForceL2) {
   const LinearParams p = params(29e9, 1.0, 0.4);
   const LinearMapping m = linear_mapping(p, kR1, kR2);
-  const LinearResult r = linear_force(p, m, kin(kZ, -1e-4, {}), LinearState{});
+  const LinearResult r = linear_force_both_widths(p, m, kin(kZ, -1e-4, {}), LinearState{});
   EXPECT_TRUE(r.active);
   EXPECT_NEAR(r.normal_force, 18221.24, rel7(18221.24));
   expect_vec_near(r.force, {0, 0, 18221.24}, rel7(18221.24));  // pushes piece 2 along +n̂
@@ -85,7 +125,7 @@ TEST(LinearForce, NormalForceL2) {
 TEST(LinearForce, NoDashpotNormalVelocityIgnored) {
   const LinearParams p = params(29e9, 1.0, 0.4);
   const LinearMapping m = linear_mapping(p, kR1, kR2);
-  const LinearResult r = linear_force(p, m, kin(kZ, -1e-4, {0, 0, -100.0}), LinearState{});
+  const LinearResult r = linear_force_both_widths(p, m, kin(kZ, -1e-4, {0, 0, -100.0}), LinearState{});
   EXPECT_NEAR(r.normal_force, 18221.24, rel7(18221.24));
 }
 
@@ -93,7 +133,7 @@ TEST(LinearForce, NoTensionWhenOpen) {
   const LinearParams p = params(29e9, 1.0, 0.4);
   const LinearMapping m = linear_mapping(p, kR1, kR2);
   for (double gap : {0.0, 1e-9, 1e-3}) {
-    const LinearResult r = linear_force(p, m, kin(kZ, gap, {5.0, 1.0, 3.0}), state({-300.0, 20.0, 0}));
+    const LinearResult r = linear_force_both_widths(p, m, kin(kZ, gap, {5.0, 1.0, 3.0}), state({-300.0, 20.0, 0}));
     EXPECT_FALSE(r.active) << gap;
     EXPECT_EQ(r.normal_force, 0.0) << gap;
     EXPECT_TRUE(r.force == Vec3{}) << gap;
@@ -107,18 +147,18 @@ TEST(LinearForce, NoTensionWhenOpen) {
 TEST(LinearForce, IncrementalShear) {
   const LinearParams p = params(29e9, 1.0, 10.0);
   const LinearMapping m = linear_mapping(p, kR1, kR2);
-  const LinearResult r = linear_force(p, m, kin(kZ, -1e-4, {10.0, 0, 0}), state({-1000.0, 0, 0}));
+  const LinearResult r = linear_force_both_widths(p, m, kin(kZ, -1e-4, {10.0, 0, 0}), state({-1000.0, 0, 0}));
   expect_vec_near(r.shear_force, {-2822.124, 0, 0}, rel7(2822.124));
   expect_vec_near(r.state.shear_force, r.shear_force, 0.0);
   EXPECT_NEAR(r.trial_shear, 2822.124, rel7(2822.124));
   expect_vec_near(r.force, {-2822.124, 0, 18221.24}, rel7(18221.24));
 
   // No relative motion: the stored force is kept.
-  const LinearResult again = linear_force(p, m, kin(kZ, -1e-4, {}), r.state);
+  const LinearResult again = linear_force_both_widths(p, m, kin(kZ, -1e-4, {}), r.state);
   expect_vec_near(again.shear_force, r.shear_force, 1e-9);
 
   // Reversing the motion brings it back.
-  const LinearResult back = linear_force(p, m, kin(kZ, -1e-4, {-10.0, 0, 0}), r.state);
+  const LinearResult back = linear_force_both_widths(p, m, kin(kZ, -1e-4, {-10.0, 0, 0}), r.state);
   expect_vec_near(back.shear_force, {-1000.0, 0, 0}, 1e-6);
 }
 
@@ -126,7 +166,7 @@ TEST(LinearForce, IncrementalShear) {
 TEST(LinearForce, CoulombClampL4L5) {
   const LinearParams p = params(29e9, 1.0, 0.4);
   const LinearMapping m = linear_mapping(p, kR1, kR2);
-  const LinearResult r = linear_force(p, m, kin(kZ, -1e-4, {0, 99.0, 0}), LinearState{});
+  const LinearResult r = linear_force_both_widths(p, m, kin(kZ, -1e-4, {0, 99.0, 0}), LinearState{});
   EXPECT_NEAR(r.trial_shear, 18039.03, rel7(18039.03));
   expect_vec_near(r.shear_force, {0, -7288.495, 0}, rel7(7288.495));
   expect_vec_near(r.state.shear_force, {0, -7288.495, 0}, rel7(7288.495));
@@ -136,7 +176,7 @@ TEST(LinearForce, ClampKeepsTheTrialDirection) {
   const LinearParams p = params(29e9, 1.0, 0.4);
   const LinearMapping m = linear_mapping(p, kR1, kR2);
   // Stored 18039.03 N along +y, increment 99 µm along +x: trial (−18039.03, 18039.03, 0), at 45°.
-  const LinearResult r = linear_force(p, m, kin(kZ, -1e-4, {99.0, 0, 0}), state({0, m.ks * 99e-6, 0}));
+  const LinearResult r = linear_force_both_widths(p, m, kin(kZ, -1e-4, {99.0, 0, 0}), state({0, m.ks * 99e-6, 0}));
   EXPECT_NEAR(r.trial_shear, 18039.03 * std::sqrt(2.0), rel7(18039.03 * std::sqrt(2.0)));
   EXPECT_NEAR(norm(r.shear_force), 7288.495, rel7(7288.495));
   EXPECT_NEAR(r.shear_force.x, -r.shear_force.y, 1e-9);
@@ -146,7 +186,7 @@ TEST(LinearForce, ClampKeepsTheTrialDirection) {
 TEST(LinearForce, ZeroFrictionGivesNoShear) {
   const LinearParams p = params(29e9, 1.0, 0.0);
   const LinearMapping m = linear_mapping(p, kR1, kR2);
-  const LinearResult r = linear_force(p, m, kin(kZ, -1e-4, {5.0, 0, 0}), LinearState{});
+  const LinearResult r = linear_force_both_widths(p, m, kin(kZ, -1e-4, {5.0, 0, 0}), LinearState{});
   EXPECT_EQ(norm(r.shear_force), 0.0);
   EXPECT_NEAR(r.normal_force, 18221.24, rel7(18221.24));
 }
@@ -157,8 +197,8 @@ TEST(LinearForce, SwappingPiecesReversesTheForce) {
   const Vec3 n{1.0 / 3.0, 2.0 / 3.0, 2.0 / 3.0};
   const Vec3 stored = Vec3{2.0, -1.0, 0.0} * 500.0;
   const Vec3 v{30.0, -10.0, 20.0};
-  const LinearResult a = linear_force(p, m, kin(n, -1e-4, v), state(stored));
-  const LinearResult b = linear_force(p, m, kin(-n, -1e-4, -v), state(-stored));
+  const LinearResult a = linear_force_both_widths(p, m, kin(n, -1e-4, v), state(stored));
+  const LinearResult b = linear_force_both_widths(p, m, kin(-n, -1e-4, -v), state(-stored));
   expect_vec_near(b.force, -a.force, 1e-9 * norm(a.force));
   expect_vec_near(b.state.shear_force, -a.state.shear_force, 1e-9 * norm(a.force));
 }

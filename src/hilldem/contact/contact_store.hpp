@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "hilldem/contact/cell_grid.hpp"
-#include "hilldem/contact/contact_kinematics.hpp"
+#include "hilldem/models/contact_kinematics.hpp"
 #include "hilldem/models/hill.hpp"
 #include "hilldem/models/linear.hpp"
 #include "hilldem/models/model_table.hpp"

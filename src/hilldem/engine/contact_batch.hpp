@@ -1,27 +1,24 @@
-// ContactBatch: the hill law of many ball-ball contacts at once, in structure-of-arrays lanes.
+// ContactBatch: many contacts' law at once, in structure-of-arrays lanes.
 //
 // Why: one contact's law is a long chain of dependent square roots and divisions (distance, normal,
-// the carried shear's magnitude, δ^{1/2}, δ^{1/4}, two norms and two clamps): ≈ 150 cycles of latency,
-// longer than the out-of-order window of a core, so a row-by-row loop runs at the speed of that chain.
-// (The linear law's chain is shorter, but the same lanes pay there too.)
-// Here the force pass gathers the existing ball-ball contacts of a block of balls into lanes (one
-// batch per model),
-// runs the law as a few simple loops over the lanes (vectorised by the compiler, every branch a
-// select), and scatters the results back. The arithmetic is that of force_row() (spec §1.1–1.3 and
-// hill Eqs. 12–21) in the same order; only the compiler's fusing of multiply-adds may differ, so
-// results agree with the row-by-row path to rounding (test ContactBatch.*).
+// the carried shear's magnitude, δ^{1/2}, δ^{1/4}, two norms and two clamps), longer than the
+// out-of-order window of a core, so a row-by-row loop runs at the speed of that chain. Here the force
+// pass gathers the existing contacts of a block of balls into lanes (one batch per model), runs the
+// model's law (models/: the same template the row-by-row path runs, over lanes::Pack instead of
+// double) on kWidth lanes at a time, and scatters the results back.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 
 #include "hilldem/core/vec3.hpp"
+#include "hilldem/models/lanes.hpp"
 
 namespace hilldem {
 
 class ContactBatch {
  public:
-  // Lane columns. Inputs are gathered by the force pass; outputs are written by hill_batch_forces().
+  // Lane columns. Inputs are gathered by the force pass; outputs are written by run_hill_lanes() or run_linear_lanes().
   enum Field : int {
     // inputs
     kDx, kDy, kDz,      // x2 − x1 [m] (periodic image applied)
@@ -39,8 +36,6 @@ class ContactBatch {
     kIr, kIm, kCn, kCs,
     kFric, kSuction, kDamp,   // μ [-], ψ [Pa], γ_h [-]
     kWet,               // 1 if M = 2 (wet) at the start of the step, else 0
-    // the mapping (spec §2.4, Table 4), built from the terms above
-    kKn, kKs, kBn, kBs, kRo,
     // outputs
     kNx, kNy, kNz,      // n̂_c
     kGap,               // g_c [m]
@@ -50,7 +45,7 @@ class ContactBatch {
     kActive,            // 1 if active after the step
     kRuptured,          // 1 if the liquid bridge ruptured this step
     kKtran, kKshear,    // k̂_n + k̂_s, k̂_s [N/m] (when asked for)
-    // batch_shares(): what the scatter adds to the two balls' sums
+    // what the scatter adds to the two balls' sums
     kMax, kMay, kMaz,   // moment on ball 1: −(R1 + g/2) n̂ × F_c [N m]
     kMbx, kMby, kMbz,   // moment on ball 2 (a wall lane: on its ball, see wall_block): −(R2 + g/2) n̂ × F_c [N m]
     kQuick,             // 1 if the row stays a contact and its force is finite (the scatter's common case)
@@ -62,6 +57,9 @@ class ContactBatch {
   static constexpr std::size_t kLanes = 64;
   // A lane whose row has no live record (see add_if).
   static constexpr std::uint32_t kNoSlot = 0xFFFFFFFFu;
+
+  // The last input field (pad_lanes copies kDx..kLastInput).
+  static constexpr int kLastInput = kWet;
 
   void clear() { size_ = 0; }
   bool full() const { return size_ == kLanes; }
@@ -110,7 +108,7 @@ class ContactBatch {
   std::size_t padded_size() const { return (size_ + kVector - 1) / kVector * kVector; }
   // The same for the geometry columns (kNx..kNz, kGap) when the lanes were given their geometry.
   void pad_geometry(std::size_t padded);
-  static constexpr std::size_t kVector = 8;
+  static constexpr std::size_t kVector = lanes::kWidth;
   std::uint32_t row(std::size_t lane) const { return row_[lane]; }
   double* col(Field f) { return data_[f]; }
   const double* col(Field f) const { return data_[f]; }
@@ -132,22 +130,25 @@ class ContactBatch {
   std::uint32_t slot_[kLanes];  // live record or kNoSlot
 };
 
-// The hill law of every lane over a step of dt [s]: geometry (Eqs. 2-3), relative velocity at the
-// contact point (§1.2), the plane's rotation carried into F^h_s (§1.3), then Eqs. 12-18 and, when
-// want_stiffness is set, Eqs. 19-21.
-void hill_batch_forces(ContactBatch& batch, double dt, bool want_stiffness);
+// One step of a batch's lanes.
+struct LaneStep {
+  double dt = 0.0;              // Δt [s]
+  bool want_stiffness = false;  // write k̂_n + k̂_s and k̂_s (the time-step estimate, density scaling)
+  double proximity = 0.0;       // [m] an inactive contact within it is kept (spec §2.5)
+  // The lanes hold n̂_c and g_c already (kNx..kNz, kGap: ball-wall rows, whose geometry is the
+  // wall's), and kDx..kDz are not read. A wall lane holds the wall's surface velocity at x_c in
+  // kVbx..kVbz, its spin in kWbx..kWbz (the twist of §1.3) and R2 = −g/2, so that the arm R2 + g/2
+  // of the second body is exactly 0 and ẋ_c(2) is the surface velocity itself (§1.2).
+  bool geometry_given = false;
+};
 
-// The linear law (spec §3) of every lane: k_n, k_s in kIr, kIm, μ in kFric; the same outputs (F^m,
-// rupture 0; the stiffnesses k_n, k_s when want_stiffness).
-// geometry_given: the lanes hold n̂_c and g_c already (kNx..kNz, kGap: ball-wall rows, whose geometry
-// is the wall's, wall_touch), and kDx..kDz are not read. A wall lane holds the wall's surface velocity
-// at x_c in kVbx..kVbz, its spin in kWbx..kWbz (the twist of §1.3) and R2 = −g/2, so that the arm
-// R2 + g/2 of the second body is exactly 0 and ẋ_c(2) is the surface velocity itself (§1.2).
-void linear_batch_forces(ContactBatch& batch, double dt, bool want_stiffness, bool geometry_given = false);
+// The hill law (models/hill.hpp, hill_law) of every lane: the mapping from the summed body terms
+// (kIr..kCs), the kinematics (models/contact_kinematics.hpp), Eqs. 12-18 and, when asked for,
+// Eqs. 19-21; then F_c, the moments and kQuick for the scatter. Ball-ball lanes only.
+void run_hill_lanes(ContactBatch& batch, const LaneStep& step);
 
-// After either law: each lane's moments on its two bodies (kMax.., kMbx..: −(R + g/2) n̂_c × F_c, the
-// contact point on the normal) and whether the scatter may take it the common way (kQuick: the
-// contact is kept, i.e. active or within `proximity` [m] (spec §2.5), and its force is finite).
-void batch_shares(ContactBatch& batch, double proximity);
+// The linear law (models/linear.hpp, linear_law) of every lane: k_n, k_s in kIr, kIm, μ in kFric;
+// the same outputs (F^m and rupture 0; the stiffnesses k_n, k_s when asked for).
+void run_linear_lanes(ContactBatch& batch, const LaneStep& step);
 
 }  // namespace hilldem

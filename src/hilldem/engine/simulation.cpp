@@ -16,18 +16,11 @@
 #include <thread>
 #include <type_traits>
 
-#if defined(__AVX512F__)
-// (GCC 12 warns that the headers' _mm512_undefined_pd() "may be used uninitialized".)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include <immintrin.h>
-#pragma GCC diagnostic pop
-#endif
-
 #include "hilldem/contact/cell_grid.hpp"
 #include "hilldem/core/error.hpp"
 #include "hilldem/engine/contact_batch.hpp"
 #include "hilldem/engine/thread_budget.hpp"
+#include "hilldem/models/lanes.hpp"
 #include "hilldem/motion/ball_step.hpp"
 
 namespace hilldem {
@@ -588,21 +581,20 @@ Simulation::RowShare Simulation::force_row(std::size_t c, double dt) {
   const double r1 = rad[a];
 
   // Geometry (spec §1.1). Neighbour pairs that are not contacts are rejected before any sqrt.
+  using lanes::v3;
   Vec3 normal;
   double gap;
   if (ball2) {
     Vec3 x2 = rec[key.b].position;
     if (contacts.image[c] != kNoImage) x2 += image_shift(contacts.image[c], box);
     const Vec3 d = x2 - x1;
-    const double dist2 = norm2(d);
-    const double rsum = r1 + rad[key.b];
     if (!contacts.exists[c]) {
-      const double reach = rsum + proximity;
-      if (dist2 > reach * reach) return {};  // a neighbour pair, not a contact
+      const double reach = r1 + rad[key.b] + proximity;
+      if (norm2(d) > reach * reach) return {};  // a neighbour pair, not a contact
     }
-    const double dist = std::sqrt(dist2);
-    normal = dist > 0.0 ? d / dist : contacts.normal[c];  // coincident centres: keep the old normal
-    gap = dist - rsum;
+    const PairGeometry<double> g = ball_pair_geometry(v3(d), r1, rad[key.b], v3(contacts.normal[c]));
+    normal = lanes::vec3(g.normal);
+    gap = g.gap;
   } else {
     const auto touch = wall_touch(walls.walls[key.b], x1, r1);
     if (!touch && !contacts.exists[c]) return {};
@@ -611,43 +603,48 @@ Simulation::RowShare Simulation::force_row(std::size_t c, double dt) {
     if (!contacts.exists[c] && gap > proximity) return {};
   }
   if (!contacts.exists[c]) create_contact(c, normal);  // created by proximity
-  const double arm1 = r1 + 0.5 * gap;                   // |x_c − x_1|
-  const Vec3 point = x1 + normal * arm1;                // x_c, centre of the gap/overlap
 
-  // Relative velocity of the material points at x_c (spec §1.2) and the mean spin about n̂_c.
-  const Vec3 v1 = rec[a].velocity + cross(rec[a].spin, normal * arm1);
-  Vec3 v2, spin2;
-  if (ball2) {
-    spin2 = rec[key.b].spin;
-    v2 = rec[key.b].velocity - cross(spin2, normal * (rad[key.b] + 0.5 * gap));
-  } else {
-    v2 = wall_point_velocity(walls.walls[key.b], point);
-    spin2 = walls.walls[key.b].spin;
-  }
-  const PlaneRotation rotation(contacts.normal[c], normal, 0.5 * dot(rec[a].spin + spin2, normal), dt);
-  const ContactKinematics kin{normal, gap, v2 - v1, dt};
-
+  // Relative velocity of the material points at x_c (spec §1.2); a wall is body 2 with the arm 0
+  // (r2 = −g/2) and its surface velocity at x_c = x1 + (R1 + g/2) n̂.
   RowOutcome out;
   out.normal = normal;
   out.gap = gap;
-  out.arm1 = arm1;
-  out.arm2 = ball2 ? rad[key.b] + 0.5 * gap : arm1;  // a wall row is collected by its ball
+  out.r1 = r1;
+  out.r2 = ball2 ? rad[key.b] : r1;  // (a wall row's second share is its ball's: wall_block)
+  const double r2 = ball2 ? rad[key.b] : -0.5 * gap;
+  Vec3 v2, spin2;
+  if (ball2) {
+    v2 = rec[key.b].velocity;
+    spin2 = rec[key.b].spin;
+  } else {
+    v2 = wall_point_velocity(walls.walls[key.b], x1 + normal * (r1 + 0.5 * gap));
+    spin2 = walls.walls[key.b].spin;
+  }
+  const Vec3 rel = lanes::vec3(contact_velocity(v3(normal), gap, r1, r2, v3(rec[a].velocity), v3(rec[a].spin),
+                                                v3(v2), v3(spin2)));
+  const ContactKinematics kin{normal, gap, rel, dt};
+  const double mean_spin = 0.5 * dot(rec[a].spin + spin2, normal);  // ½(ω1 + ω2)·n̂ [rad/s] (§1.3)
+  const Vec3 carried = carry_into_plane(contacts.shear_state[c], contacts.normal[c], normal, mean_spin, dt);
   out.moisture = contacts.moisture[c];
   StiffnessEstimate stiff;
-  if (contacts.model[c] == ModelKind::Hill) {
-    const HillState prev{rotation.carry(contacts.shear_state[c]), contacts.moisture[c]};
-    const HillResult r = hill_force(contacts.hill_params[c], contacts.hill_map[c], kin, prev);
-    out.shear = r.state.shear_hm;
-    out.moisture = r.state.moisture;
-    out.force = r.force, out.normal_force = r.surface_normal, out.moisture_force = r.moisture_force;
-    out.trial_shear = r.trial_shear, out.active = r.active;
-    if (out.active && want_stiffness) stiff = hill_timestep_stiffness(contacts.hill_params[c], contacts.hill_map[c], gap);
-  } else {
-    const LinearState prev{rotation.carry(contacts.shear_state[c])};
-    const LinearResult r = linear_force(contacts.linear_params[c], contacts.linear_map[c], kin, prev);
-    out.shear = r.state.shear_force;
-    out.force = r.force, out.normal_force = r.normal_force, out.trial_shear = r.trial_shear, out.active = r.active;
-    if (out.active) stiff = {contacts.linear_map[c].kn, contacts.linear_map[c].ks};
+  // (Exhaustive: a model without a case here does not compile, -Werror=switch.)
+  switch (contacts.model[c]) {
+    case ModelKind::Hill: {
+      const HillResult r = hill_force(contacts.hill_params[c], contacts.hill_map[c], kin, HillState{carried, out.moisture});
+      out.shear = r.state.shear_hm;
+      out.moisture = r.state.moisture;
+      out.force = r.force, out.normal_force = r.surface_normal, out.moisture_force = r.moisture_force;
+      out.trial_shear = r.trial_shear, out.active = r.active;
+      if (out.active && want_stiffness) stiff = hill_timestep_stiffness(contacts.hill_params[c], contacts.hill_map[c], gap);
+      break;
+    }
+    case ModelKind::Linear: {
+      const LinearResult r = linear_force(contacts.linear_params[c], contacts.linear_map[c], kin, LinearState{carried});
+      out.shear = r.state.shear_force;
+      out.force = r.force, out.normal_force = r.normal_force, out.trial_shear = r.trial_shear, out.active = r.active;
+      if (out.active) stiff = {contacts.linear_map[c].kn, contacts.linear_map[c].ks};
+      break;
+    }
   }
   out.k_tran = stiff.kn + stiff.ks;
   out.k_shear = stiff.ks;
@@ -655,7 +652,10 @@ Simulation::RowShare Simulation::force_row(std::size_t c, double dt) {
   // Accumulated shear displacement (reported, not used by the laws): rotated with the plane (and
   // cleared again by store_row if the contact is deleted).
   if (settings.track_shear_displacement)
-    contacts.shear_disp[c] = out.active ? rotation.rotate(contacts.shear_disp[c]) + kin.shear_rate() * dt : Vec3{};
+    contacts.shear_disp[c] =
+        out.active ? lanes::vec3(rotate_with_plane(v3(contacts.shear_disp[c]), v3(contacts.normal[c]), v3(normal), mean_spin, dt)) +
+                         kin.shear_rate() * dt
+                   : Vec3{};
   RowShare share;
   store_row(c, out, want_stiffness, true, share);
   return share;
@@ -670,8 +670,8 @@ HILLDEM_INLINE Simulation::RowOutcome Simulation::lane_outcome(const ContactBatc
   RowOutcome out;
   out.normal = batch.get3(F::kNx, lane);
   out.gap = batch.col(F::kGap)[lane];
-  out.arm1 = batch.col(F::kR1)[lane] + 0.5 * out.gap;
-  out.arm2 = wall_row ? out.arm1 : batch.col(F::kR2)[lane] + 0.5 * out.gap;
+  out.r1 = batch.col(F::kR1)[lane];
+  out.r2 = wall_row ? out.r1 : batch.col(F::kR2)[lane];
   out.force = batch.get3(F::kFx, lane);
   out.shear = batch.get3(F::kShx, lane);
   out.normal_force = batch.col(F::kFn)[lane];
@@ -700,10 +700,11 @@ HILLDEM_INLINE void Simulation::store_row(std::size_t c, const RowOutcome& out, 
   // (The share is written where it belongs, field by field: built on the stack and copied, its
   // 32-byte reloads of the fields just stored stalled store forwarding; perf annotate put 11 % of the
   // in-cache bench on that copy, and writing in place was 1.03 × overall.)
-  const Vec3 torque = cross(out.normal, out.force);
+  const ContactMoments<double> m =
+      contact_moments(lanes::v3(out.normal), out.gap, out.r1, out.r2, lanes::v3(out.force));
   share.force = -out.force;
-  share.moment = torque * -out.arm1;
-  share.moment2 = torque * -out.arm2;
+  share.moment = lanes::vec3(m.on1);
+  share.moment2 = lanes::vec3(m.on2);
   share.ok = std::isfinite(out.force.x + out.force.y + out.force.z);
   if (want_stiffness) {  // what add_row_stiffness reads (zero when inactive)
     share.k_tran = out.k_tran;
@@ -735,10 +736,9 @@ HILLDEM_INLINE void Simulation::store_row(std::size_t c, const RowOutcome& out, 
 
 HILLDEM_INLINE void Simulation::store_kept_lane(std::size_t c, const ContactBatch& batch, std::size_t lane,
                                                bool want_stiffness, bool reported, bool history) {
-  // The columns of store_row for a contact that stays (written in the same cases). Going through a
-  // RowOutcome and a RowShare cost ≈ 45 instructions a lane more (callgrind: 163 against 108, plus
-  // 11 in batch_shares): the outcome's fields copied, the moments computed one lane at a time, the
-  // moisture read back, the keys read again.
+  // The columns of store_row for a contact that stays (written in the same cases), straight from the
+  // lanes: no RowOutcome and RowShare copied, no moments computed one lane at a time, no keys read
+  // again (docs/performance.md).
   using F = ContactBatch;
   if (history) {
     contacts.shear_state[c] = batch.get3(F::kShx, lane);
@@ -781,33 +781,8 @@ HILLDEM_INLINE bool pair_within_reach(const Kin& ka, const Kin& kb, ImageCode im
 }  // namespace
 
 #if defined(__AVX512F__)
-namespace {
-// The 8 x 8 transpose of doubles: r[i] holds lane i's eight fields, c[j] field j of the eight lanes
-// (unpack pairs of lanes, then pairs of pairs, then the two halves).
-// Eight 32-bit lane indices (a batch's slots or balls) from p, as eight 64-bit lanes.
-HILLDEM_INLINE __m512i widen8(const std::uint32_t* p) {
-  return _mm512_cvtepu32_epi64(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)));
-}
-HILLDEM_INLINE void transpose8(const __m512d r[8], __m512d c[8]) {
-  __m512d t[8], u[8];
-  for (int k = 0; k < 4; ++k) {
-    t[2 * k] = _mm512_unpacklo_pd(r[2 * k], r[2 * k + 1]);      // fields 0 2 4 6 of two lanes
-    t[2 * k + 1] = _mm512_unpackhi_pd(r[2 * k], r[2 * k + 1]);  // fields 1 3 5 7
-  }
-  const __m512i lo = _mm512_setr_epi64(0, 1, 8, 9, 4, 5, 12, 13);
-  const __m512i hi = _mm512_setr_epi64(2, 3, 10, 11, 6, 7, 14, 15);
-  for (int k = 0; k < 2; ++k) {  // lanes 0-3 (k = 0) and 4-7 (k = 1)
-    u[4 * k + 0] = _mm512_permutex2var_pd(t[4 * k + 0], lo, t[4 * k + 2]);  // fields 0 | 4 of four lanes
-    u[4 * k + 1] = _mm512_permutex2var_pd(t[4 * k + 0], hi, t[4 * k + 2]);  // 2 | 6
-    u[4 * k + 2] = _mm512_permutex2var_pd(t[4 * k + 1], lo, t[4 * k + 3]);  // 1 | 5
-    u[4 * k + 3] = _mm512_permutex2var_pd(t[4 * k + 1], hi, t[4 * k + 3]);  // 3 | 7
-  }
-  c[0] = _mm512_shuffle_f64x2(u[0], u[4], 0x44), c[4] = _mm512_shuffle_f64x2(u[0], u[4], 0xEE);
-  c[2] = _mm512_shuffle_f64x2(u[1], u[5], 0x44), c[6] = _mm512_shuffle_f64x2(u[1], u[5], 0xEE);
-  c[1] = _mm512_shuffle_f64x2(u[2], u[6], 0x44), c[5] = _mm512_shuffle_f64x2(u[2], u[6], 0xEE);
-  c[3] = _mm512_shuffle_f64x2(u[3], u[7], 0x44), c[7] = _mm512_shuffle_f64x2(u[3], u[7], 0xEE);
-}
-}  // namespace
+using lanes::transpose8;
+using lanes::widen8;
 #endif
 
 void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
@@ -1031,10 +1006,10 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
   // The law of the gathered lanes, and their results into the rows and the balls.
   auto flush = [&](ContactBatch& batch) {
     fill_lanes(batch, &batch == &hill);
-    if (&batch == &hill) hill_batch_forces(batch, dt, want_stiffness);
-    else linear_batch_forces(batch, dt, want_stiffness);
+    const LaneStep step{dt, want_stiffness, proximity};
+    if (&batch == &hill) run_hill_lanes(batch, step);
+    else run_linear_lanes(batch, step);
     batched_count += static_cast<std::int64_t>(batch.size());
-    batch_shares(batch, proximity);
     const double* quick = batch.col(F::kQuick);
     // One lane's results into its row (or live record) and its balls' sums, in lane order.
     auto scatter_lane = [&](std::size_t lane) __attribute__((always_inline)) {
@@ -1187,20 +1162,23 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
         }
         // A neighbour pair beyond reach gives nothing to either ball.
         if (!exists && !within_reach(ka, b, contacts.image[c])) continue;
-        if (!exists) {
+        ContactBatch* batch = nullptr;  // the model's batch (exhaustive: -Werror=switch)
+        switch (contacts.model[c]) {
+          case ModelKind::Hill: batch = &hill; break;
+          case ModelKind::Linear: batch = &linear; break;
+        }
+        if (!exists || batch == nullptr) {  // a new contact, or a model without a batch: row by row
           if (hill.size() > 0) flush(hill);
           if (linear.size() > 0) flush(linear);
           add_share(c, force_row(c, dt));
           continue;
         }
-        const bool is_hill = contacts.model[c] == ModelKind::Hill;
-        ContactBatch& batch = is_hill ? hill : linear;
-        ContactBatch& other = is_hill ? linear : hill;
+        ContactBatch& other = batch == &hill ? linear : hill;
         if (other.size() > 0) flush(other);
-        if (batch.full()) flush(batch);
+        if (batch->full()) flush(*batch);
         // The lane's inputs are read when the batch runs (fill_lanes).
-        batch.add(static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b),
-                  contacts.image[c]);
+        batch->add(static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b),
+                   contacts.image[c]);
       }
     };
     if (records) {
@@ -1271,9 +1249,8 @@ void Simulation::wall_block(std::size_t k0, std::size_t k1, double dt, BlockScra
     if (!share.ok) bad_row = std::min(bad_row, c);
   };
   auto flush = [&] {
-    linear_batch_forces(batch, dt, want_stiffness, /*geometry_given=*/true);
+    run_linear_lanes(batch, LaneStep{dt, want_stiffness, settings.proximity, /*geometry_given=*/true});
     batched_count += static_cast<std::int64_t>(batch.size());
-    batch_shares(batch, settings.proximity);
     const double* quick = batch.col(F::kQuick);
     for (std::size_t lane = 0; lane < batch.size(); ++lane) {
       const std::size_t c = batch.row(lane);

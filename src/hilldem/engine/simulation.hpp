@@ -225,7 +225,9 @@ class Simulation {
   struct RowOutcome {
     Vec3 normal;                  // n̂_c
     double gap = 0.0;             // g_c [m]
-    double arm1 = 0.0, arm2 = 0.0;  // R + g/2 [m] of the pair loop's ball and of the late-collecting body
+    // [m] the radii of the moments' arms R + g/2 (contact_moments): of the pair loop's ball and of the
+    // body that collects the second share (a wall row's: its ball's, as the wall's arm is 0)
+    double r1 = 0.0, r2 = 0.0;
     Vec3 force;                   // F_c [N] (zero if inactive)
     Vec3 shear;                   // shear force carried to the next step [N]
     double normal_force = 0.0, moisture_force = 0.0, trial_shear = 0.0;  // [N]
@@ -242,7 +244,7 @@ class Simulation {
   void fill_lanes(ContactBatch& batch, bool hill) const;
   // A batch lane's results as a row outcome (wall_row: a ball-wall lane of wall_block).
   RowOutcome lane_outcome(const ContactBatch& batch, std::size_t lane, bool wall_row) const;
-  // store_row for a lane that batch_shares() marked kQuick (the contact stays, its force is finite):
+  // store_row for a lane that the lanes marked kQuick (the contact stays, its force is finite):
   // the same columns, straight from the lanes. The shares come from the lanes too (kMax.., kMbx..).
   void store_kept_lane(std::size_t c, const ContactBatch& batch, std::size_t lane, bool want_stiffness, bool reported,
                        bool history = true);
