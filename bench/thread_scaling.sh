@@ -1,5 +1,5 @@
 #!/bin/sh
-# hilldem on 2 threads against 1 thread on the 100,800-sphere bed (issue #4: at least 1.8 x).
+# hilldem on 2 threads against 1 thread on the 100,800-sphere bed.
 #
 #   bench/thread_scaling.sh [rounds] [steps] [replicate] [threads]
 #

@@ -72,8 +72,7 @@ HILLDEM_INLINE Vec3 wall_point_velocity(const Wall& w, const Vec3& x) {
   }
   return v;
 }
-// (Inline: it runs for every wall row of every step. Out of line, the C5b hill triaxial test was
-// 1.05 × slower, with the same history; inlining wall_touch as well gained nothing more.)
+// (Inline: it runs for every wall row of every step, on the lab tests' hot path.)
 
 // Advance the wall's geometry by its imposed motion over dt [s].
 void advance_wall(Wall& w, double dt);
