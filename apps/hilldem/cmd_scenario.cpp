@@ -45,10 +45,10 @@ std::vector<Command> add_scenario_commands(CLI::App& app) {
   auto* check = app.add_subcommand("check", "Validate a scenario file without running it");
   check->add_option("file", o->file, "scenario file (.toml)")->required();
   out.push_back({check, [o] {
-                   const Scenario sc = load_scenario_file(o->file);
+                   const ScenarioDescription sc = read_scenario_file(o->file);  // read and validated, not built
                    std::cout << fmt::format("{}: valid ({} balls, {} walls, {} assignment rules, {} stages, {} histories)\n",
                                             o->file, sc.sim.balls.size(), sc.sim.walls.size(),
-                                            sc.sim.table.rules.size(), sc.stages.size(), sc.histories.size());
+                                            sc.sim.rules.size(), sc.stages.size(), sc.histories.size());
                    return 0;
                  }});
 

@@ -5,14 +5,17 @@
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <initializer_list>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "hilldem/core/error.hpp"
 #include "hilldem/io/runner.hpp"
 #include "hilldem/io/scenario.hpp"
+#include "hilldem/io/state_io.hpp"
 
 namespace {
 
@@ -518,6 +521,113 @@ emod = 2e8
   ASSERT_GE(c12, 0);
   EXPECT_EQ(sc.sim.contacts.rule[c12], 0);
   EXPECT_TRUE(Mentions(hilldem::contact_listing(sc.sim), {"rule 1 'anything'"}));
+}
+
+
+// ---- the reader's plain data (read_scenario) and the builder (build_scenario, build_simulation) ----
+
+TEST(ScenarioDescription, ReaderFillsPlainData) {
+  const hilldem::ScenarioDescription d = hilldem::read_scenario(kBase, kFile);
+  EXPECT_EQ(d.file, kFile);
+  EXPECT_EQ(d.text, kBase);
+  EXPECT_EQ(d.title, "base");
+  ASSERT_EQ(d.sim.balls.size(), 2u);
+  EXPECT_EQ(d.sim.balls[0].id, 1);
+  EXPECT_EQ(d.sim.balls[0].fixity, hilldem::kFixAll);
+  EXPECT_DOUBLE_EQ(d.sim.balls[0].density, 2650.0);
+  EXPECT_DOUBLE_EQ(d.sim.balls[0].young_mod, 29e9);
+  EXPECT_EQ(d.sim.balls[1].id, 2);
+  EXPECT_DOUBLE_EQ(d.sim.balls[1].position.z, 9.99e-3);
+  EXPECT_EQ(d.sim.balls[1].groups, d.sim.groups.find("top"));
+  ASSERT_EQ(d.sim.walls.size(), 1u);
+  EXPECT_EQ(d.sim.walls[0].name, "floor");
+  ASSERT_EQ(d.sim.rules.size(), 2u);
+  EXPECT_EQ(d.sim.rules[0].model, hilldem::ModelKind::Hill);
+  EXPECT_DOUBLE_EQ(d.sim.rules[1].linear.emod, 29e6);
+  EXPECT_FALSE(d.sim.settings.auto_timestep);
+  EXPECT_DOUBLE_EQ(d.sim.settings.gravity.z, -9.81);
+  EXPECT_EQ(d.sim.find_ball(2), 1);
+  EXPECT_EQ(d.sim.find_ball(3), -1);
+  EXPECT_EQ(d.sim.walls_named("floor"), std::vector<std::size_t>{0});
+  EXPECT_TRUE(d.sim.walls_named("roof").empty());
+  ASSERT_EQ(d.stages.size(), 2u);
+  EXPECT_EQ(d.histories.size(), 1u);
+}
+
+TEST(ScenarioDescription, BuildGivesWhatLoadGives) {
+  // load_scenario is read_scenario then build_scenario: the same state, bit for bit, before and
+  // after cycling, for the base scenario and every example.
+  std::vector<std::pair<std::string, std::string>> cases{{kFile, kBase}};
+  const std::filesystem::path dir = std::filesystem::path(HILLDEM_SOURCE_DIR) / "examples";
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    if (e.path().extension() == ".toml") {
+      std::ifstream in(e.path());
+      std::stringstream text;
+      text << in.rdbuf();
+      cases.emplace_back(e.path().string(), text.str());
+    }
+  for (const auto& [file, text] : cases) {
+    SCOPED_TRACE(file);
+    Scenario loaded = load_scenario(text, file);
+    Scenario built = hilldem::build_scenario(hilldem::read_scenario(text, file));
+    EXPECT_EQ(hilldem::state_difference(loaded.sim, built.sim), "");
+    EXPECT_EQ(built.sim.groups.describe(~std::uint64_t{0}), loaded.sim.groups.describe(~std::uint64_t{0}));
+    ASSERT_EQ(built.sim.table.rules.size(), loaded.sim.table.rules.size());
+    EXPECT_EQ(built.stages.size(), loaded.stages.size());
+    EXPECT_EQ(built.histories.size(), loaded.histories.size());
+    EXPECT_EQ(built.servos.size(), loaded.servos.size());
+    EXPECT_EQ(built.text, text);
+    if (loaded.sim.balls.size() > 2000) continue;  // the cycles below only for the small ones
+    loaded.sim.cycle(3);
+    built.sim.cycle(3);
+    EXPECT_EQ(hilldem::state_digest(built.sim), hilldem::state_digest(loaded.sim));
+  }
+}
+
+TEST(ScenarioDescription, BuildSimulationFromDataWrittenInCode) {
+  // No TOML: two touching balls on a floor, one rule for each kind of contact.
+  hilldem::SimulationDescription d;
+  d.settings.gravity = {0.0, 0.0, -9.81};
+  d.settings.auto_timestep = false;
+  d.settings.timestep = 1e-6;
+  const std::uint64_t grains = d.groups.bit("grains");
+  for (int k = 0; k < 2; ++k) {
+    hilldem::BallInit b;
+    b.id = 10 + k;
+    b.position = {0.0, 0.0, 1.99e-2 * k};
+    b.radius = 1e-2;
+    b.density = 2650.0;
+    b.groups = grains;
+    d.balls.push_back(b);
+  }
+  hilldem::Wall floor;
+  floor.name = "floor";
+  floor.point = {0.0, 0.0, -0.99e-2};
+  d.walls.push_back(floor);
+  hilldem::ModelRule bb;
+  bb.name = "grains";
+  bb.linear.emod = 1e8;
+  bb.groups1 = grains;
+  hilldem::ModelRule bw = bb;
+  bw.name = "floor";
+  bw.kind = hilldem::ContactKind::BallWall;
+  d.rules = {bb, bw};
+
+  hilldem::Simulation sim = hilldem::build_simulation(d);
+  ASSERT_EQ(sim.balls.size(), 2u);
+  EXPECT_EQ(sim.balls.find(11), 1);
+  EXPECT_NEAR(sim.balls.mass[0], 4.0 / 3.0 * 3.141592653589793 * 1e-6 * 2650.0, 1e-15);
+  EXPECT_EQ(sim.walls.find("floor"), 0);
+  EXPECT_EQ(sim.groups.find("grains"), grains);
+  ASSERT_EQ(sim.table.rules.size(), 2u);
+  EXPECT_EQ(sim.time, 0.0);
+  sim.update_forces();
+  const long c = sim.find_ball_ball(10, 11);
+  ASSERT_GE(c, 0);
+  EXPECT_EQ(sim.contacts.rule[c], 0);
+  EXPECT_GE(sim.find_ball_wall(10, 0), 0);
+  sim.cycle(2);
+  EXPECT_EQ(sim.steps, 2);
 }
 
 }  // namespace

@@ -70,4 +70,15 @@ std::string GroupNames::describe(std::uint64_t mask) const {
   return out.empty() ? "-" : out;
 }
 
+std::vector<std::string> group_names(const GroupNames& g) {
+  std::vector<std::string> names;
+  for (int k = 0; k < 64; ++k) {
+    const std::uint64_t bit = std::uint64_t{1} << k;
+    const std::string name = g.describe(bit);
+    if (g.find(name) != bit) break;
+    names.push_back(name);
+  }
+  return names;
+}
+
 }  // namespace hilldem

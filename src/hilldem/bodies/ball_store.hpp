@@ -90,4 +90,8 @@ class GroupNames {
   std::vector<std::string> names_;
 };
 
+// The names of bits 0, 1, 2, ... in order (checkpoints and snapshots list them), up to the first
+// that does not read back as its own bit (an empty name, which describe shows as "-").
+std::vector<std::string> group_names(const GroupNames& g);
+
 }  // namespace hilldem

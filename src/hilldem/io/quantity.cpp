@@ -52,7 +52,7 @@ std::string quantity_catalogue() {
          "\n" + names("contact.", kContactFields);
 }
 
-Quantity read_quantity(TableReader& t, const Simulation& sim) {
+Quantity read_quantity(TableReader& t, const SimulationDescription& sim) {
   Quantity q;
   q.name = t.string("quantity", std::nullopt);
   const auto dot = q.name.find('.');
@@ -67,14 +67,12 @@ Quantity read_quantity(TableReader& t, const Simulation& sim) {
   q.unit = info->unit;
 
   auto ball_id = [&](const std::string& key, std::int64_t id) {
-    if (sim.balls.find(id) < 0) t.fail(key, "no ball with id " + std::to_string(id));
+    if (sim.find_ball(id) < 0) t.fail(key, "no ball with id " + std::to_string(id));
     return id;
   };
   auto read_walls = [&] {
     const std::string w = t.string("wall", std::nullopt);
-    const std::uint64_t bit = sim.groups.find(w);
-    for (std::size_t k = 0; k < sim.walls.size(); ++k)
-      if (sim.walls.walls[k].name == w || (bit && (sim.walls.walls[k].groups & bit))) q.walls.push_back(k);
+    q.walls = sim.walls_named(w);
     if (q.walls.empty()) t.fail("wall", "no wall named or grouped \"" + w + "\"");
     return w;
   };

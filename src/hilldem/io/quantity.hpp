@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "hilldem/engine/simulation.hpp"
+#include "hilldem/io/simulation_description.hpp"
 #include "hilldem/io/toml_reader.hpp"
 
 namespace hilldem {
@@ -24,8 +25,9 @@ struct Quantity {
   std::string target_text;     // "balls 1-2", for listings
 };
 
-// Read `quantity` plus its target keys (`ball`, `balls`, `wall`) from a table.
-Quantity read_quantity(TableReader& t, const Simulation& sim);
+// Read `quantity` plus its target keys (`ball`, `balls`, `wall`) from a table; the targets must
+// exist in `sim`.
+Quantity read_quantity(TableReader& t, const SimulationDescription& sim);
 // Value in SI units; NaN when the target does not exist now (e.g. a deleted contact).
 double evaluate(const Simulation& sim, const Quantity& q);
 // The list of known quantities with their units, for --help and docs.

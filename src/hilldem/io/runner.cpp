@@ -720,31 +720,34 @@ void restore_scenario(const CheckpointReader& r, Scenario& sc) {
   // The state first: its size bounds the scenario's (a damaged text cannot ask for millions of balls).
   Simulation restored;
   read_simulation(r, restored, true);
+  ScenarioDescription d;
   try {
     ScenarioLimits limits;
     limits.max_balls = std::max<std::uint64_t>(restored.balls.size(), 1);
-    sc = load_scenario(text, file, limits);
+    d = read_scenario(text, file, limits);
   } catch (const InputError& e) {
     throw InputError(r.source() + ": the scenario it carries does not load: " + e.what());
   }
   // The stages refer to balls and walls by index and to groups by bit: they must be the scenario's.
-  const Simulation& fresh = sc.sim;
+  const SimulationDescription& fresh = d.sim;
   auto mismatch = [&](const std::string& what) {
     throw InputError(r.source() + ": the saved state does not match its scenario (" + what + ")");
   };
   if (restored.balls.size() != fresh.balls.size())
     mismatch(fmt::format("{} balls saved, the scenario has {}", restored.balls.size(), fresh.balls.size()));
   for (std::size_t i = 0; i < fresh.balls.size(); ++i)
-    if (restored.balls.id[i] != fresh.balls.id[i]) mismatch(fmt::format("ball {} is saved at index {}", restored.balls.id[i], i));
+    if (restored.balls.id[i] != fresh.balls[i].id) mismatch(fmt::format("ball {} is saved at index {}", restored.balls.id[i], i));
   if (restored.walls.size() != fresh.walls.size())
     mismatch(fmt::format("{} walls saved, the scenario has {}", restored.walls.size(), fresh.walls.size()));
   for (std::size_t w = 0; w < fresh.walls.size(); ++w)
-    if (restored.walls.walls[w].name != fresh.walls.walls[w].name) mismatch("wall '" + restored.walls.walls[w].name + "'");
+    if (restored.walls.walls[w].name != fresh.walls[w].name) mismatch("wall '" + restored.walls.walls[w].name + "'");
   for (int k = 0; k < 64; ++k) {
     const std::uint64_t bit = std::uint64_t{1} << k;
     if (fresh.groups.describe(bit) != restored.groups.describe(bit)) mismatch("group names");
   }
-  if (restored.table.rules.size() != fresh.table.rules.size()) mismatch("assignment rules");
+  if (restored.table.rules.size() != fresh.rules.size()) mismatch("assignment rules");
+  // The scenario's plan with the restored state (the description's bodies are not built).
+  static_cast<ScenarioPlan&>(sc) = std::move(d);
   sc.sim = std::move(restored);
   // The restore must give back exactly the state that was saved.
   SectionReader meta = r.section(kMetaSection);

@@ -85,8 +85,8 @@ class Reader {
   Reader(const toml::table& root, std::string file, const ScenarioLimits& limits)
       : root_(root, file, ""), file_(std::move(file)), limits_(limits) {}
 
-  Scenario read() {
-    Scenario sc;
+  ScenarioDescription read() {
+    ScenarioDescription sc;
     sc.file = file_;
     sc.title = root_.string("title", "");
     read_simulation(sc);
@@ -111,7 +111,7 @@ class Reader {
   }
 
  private:
-  void read_simulation(Scenario& sc) {
+  void read_simulation(ScenarioDescription& sc) {
     SimulationSettings& s = sc.sim.settings;
     auto t = root_.table("simulation");
     if (!t) return;
@@ -146,7 +146,7 @@ class Reader {
     t->finish();
   }
 
-  void read_output(Scenario& sc) {
+  void read_output(ScenarioDescription& sc) {
     auto t = root_.table("output");
     if (!t) return;
     sc.output_dir = t->string("dir", "");
@@ -157,7 +157,7 @@ class Reader {
     t->finish();
   }
 
-  void read_snapshots(Scenario& sc) {
+  void read_snapshots(ScenarioDescription& sc) {
     auto t = root_.table("snapshots");
     if (!t) return;
     SnapshotSettings& s = sc.snapshots;
@@ -173,7 +173,7 @@ class Reader {
     t->finish();
   }
 
-  void read_checkpoints(Scenario& sc) {
+  void read_checkpoints(ScenarioDescription& sc) {
     auto t = root_.table("checkpoints");
     if (!t) return;
     CheckpointSettings& c = sc.checkpoints;
@@ -186,21 +186,18 @@ class Reader {
   }
 
   // [[servo]]: a Servo (control/servo.hpp) on the walls named or grouped `wall`.
-  void read_servo(TableReader& t, Scenario& sc) {
-    const Simulation& sim = sc.sim;
+  void read_servo(TableReader& t, ScenarioDescription& sc) {
+    const SimulationDescription& sim = sc.sim;
     const std::string name = t.string("name", std::nullopt);
     if (name.empty()) t.fail("name", "must not be empty");
     if (sc.find_servo(name) >= 0) t.fail("name", "servo \"" + name + "\" is defined twice");
     const std::string wall = t.string("wall", std::nullopt);
-    std::vector<std::size_t> walls;
-    const std::uint64_t bit = sim.groups.find(wall);
-    for (std::size_t k = 0; k < sim.walls.size(); ++k)
-      if (sim.walls.walls[k].name == wall || (bit && (sim.walls.walls[k].groups & bit))) walls.push_back(k);
+    const std::vector<std::size_t> walls = sim.walls_named(wall);
     if (walls.empty()) t.fail("wall", "no wall named or grouped \"" + wall + "\"");
     for (const ScenarioServo& other : sc.servos)
       for (std::size_t w : walls)
         if (std::find(other.walls.begin(), other.walls.end(), w) != other.walls.end())
-          t.fail("wall", "wall '" + sim.walls.walls[w].name + "' is already driven by servo \"" + other.name + "\"");
+          t.fail("wall", "wall '" + sim.walls[w].name + "' is already driven by servo \"" + other.name + "\"");
     const bool radial = t.choice("mode", "axial", {"axial", "radial"}) == "radial";
     Vec3 outward;
     if (!radial) {
@@ -214,16 +211,16 @@ class Reader {
     std::function<double(const Simulation&)> area;
     if (radial) {
       for (std::size_t w : walls)
-        if (sim.walls.walls[w].shape != WallShape::Cylinder)
-          t.fail("mode", "\"radial\" drives cylinders; wall '" + sim.walls.walls[w].name + "' is not one");
+        if (sim.walls[w].shape != WallShape::Cylinder)
+          t.fail("mode", "\"radial\" drives cylinders; wall '" + sim.walls[w].name + "' is not one");
     }
     if (t.has("area") && t.is_string("area")) {
       t.choice("area", std::nullopt, {"auto"});
       if (radial) {
         // Lateral area 2πR·height of each cylinder, at its current radius.
         for (std::size_t w : walls)
-          if (!(sim.walls.walls[w].lo < sim.walls.walls[w].hi))
-            t.fail("area", "\"auto\" needs cylinders with a finite extent; wall '" + sim.walls.walls[w].name + "' is infinite");
+          if (!(sim.walls[w].lo < sim.walls[w].hi))
+            t.fail("area", "\"auto\" needs cylinders with a finite extent; wall '" + sim.walls[w].name + "' is infinite");
         area = [walls](const Simulation& s) {
           double a = 0.0;
           for (std::size_t w : walls) {
@@ -235,7 +232,7 @@ class Reader {
       } else {
         double a = 0.0;
         for (std::size_t w : walls) {
-          const Wall& f = sim.walls.walls[w];
+          const Wall& f = sim.walls[w];
           if (f.shape != WallShape::Facet)
             t.fail("area", "\"auto\" sums facet areas; wall '" + f.name + "' is not a facet: give the area in m^2");
           a += 0.5 * norm(cross(f.vertex[1] - f.vertex[0], f.vertex[2] - f.vertex[0]));
@@ -254,7 +251,7 @@ class Reader {
   }
 
   // A servo.* quantity (histories and probes): the servo index; the field and unit go into q.
-  int read_servo_quantity(TableReader& t, const Scenario& sc, Quantity& q) {
+  int read_servo_quantity(TableReader& t, const ScenarioDescription& sc, Quantity& q) {
     q.name = t.string("quantity", std::nullopt);
     q.field = q.name.substr(6);
     const char* unit = nullptr;
@@ -295,7 +292,7 @@ class Reader {
     return it->second;
   }
 
-  BallInit common_ball(TableReader& t, Simulation& sim) {
+  BallInit common_ball(TableReader& t, SimulationDescription& sim) {
     BallInit b;
     const Material& m = material(t);
     b.density = m.density;
@@ -309,14 +306,14 @@ class Reader {
     return b;
   }
 
-  void add_ball(TableReader& t, Simulation& sim, const BallInit& b) {
+  void add_ball(TableReader& t, SimulationDescription& sim, const BallInit& b) {
     if (sim.balls.size() >= limits_.max_balls)
       t.fail("id", "more than " + std::to_string(limits_.max_balls) + " balls (the limit for one scenario)");
-    if (!ids_.insert(b.id).second) t.fail("id", "ball id " + std::to_string(b.id) + " is used twice");
-    sim.balls.add(b);
+    if (!ids_.emplace(b.id, sim.balls.size()).second) t.fail("id", "ball id " + std::to_string(b.id) + " is used twice");
+    sim.balls.push_back(b);
   }
 
-  void read_ball(TableReader& t, Simulation& sim) {
+  void read_ball(TableReader& t, SimulationDescription& sim) {
     BallInit b = common_ball(t, sim);
     b.id = t.integer("id", std::nullopt, 0, INT64_MAX);
     b.position = t.vec3("position", std::nullopt, Range::any(), "[m]");
@@ -324,7 +321,7 @@ class Reader {
     add_ball(t, sim, b);
   }
 
-  void read_ball_grid(TableReader& t, Simulation& sim) {
+  void read_ball_grid(TableReader& t, SimulationDescription& sim) {
     BallInit b = common_ball(t, sim);
     std::int64_t id = t.integer("first_id", std::nullopt, 0, INT64_MAX);
     const Vec3 origin = t.vec3("origin", std::nullopt, Range::any(), "[m]");
@@ -351,7 +348,7 @@ class Reader {
   }
 
   // [[packing]]: balls from a file (path relative to the scenario file).
-  void read_packing_table(TableReader& t, Simulation& sim) {
+  void read_packing_table(TableReader& t, SimulationDescription& sim) {
     const std::string file = t.string("file", std::nullopt);
     const std::string format = t.choice("format", "lammps", {"lammps", "xyzr"});
     const Material& m = material(t);
@@ -361,7 +358,7 @@ class Reader {
                          rep[1] > 10000 || rep[2] > 10000 || rep[0] * rep[1] * rep[2] > 10000))
       t.fail("replicate", "must be [nx, ny, nz] with each >= 1 (at most 10000 copies in all)");
     std::int64_t next_id = 1;
-    for (std::int64_t id : ids_) next_id = std::max(next_id, id + 1);
+    for (const auto& known : ids_) next_id = std::max(next_id, known.first + 1);
     std::int64_t id = t.integer("first_id", next_id, 0, INT64_MAX);
     t.finish();
     const std::filesystem::path base = std::filesystem::path(file_).parent_path();
@@ -401,27 +398,27 @@ class Reader {
 
   // The hill model needs E > 0 on both balls (spec §2.4): refuse a material without it when a hill
   // rule can apply to its balls.
-  void check_hill_moduli(const Simulation& sim) {
-    for (const ModelRule& r : sim.table.rules) {
+  void check_hill_moduli(const SimulationDescription& sim) {
+    for (const ModelRule& r : sim.rules) {
       if (r.model != ModelKind::Hill) continue;
       for (std::size_t i = 0; i < sim.balls.size(); ++i) {
-        const bool in_rule = (r.groups1 == 0 || (sim.balls.groups[i] & r.groups1)) ||
-                             (r.groups2 == 0 || (sim.balls.groups[i] & r.groups2));
-        if (in_rule && !(sim.balls.young_mod[i] > 0.0))
+        const bool in_rule = (r.groups1 == 0 || (sim.balls[i].groups & r.groups1)) ||
+                             (r.groups2 == 0 || (sim.balls[i].groups & r.groups2));
+        if (in_rule && !(sim.balls[i].young_mod > 0.0))
           throw InputError(fmt::format("{}: key 'material.young_mod': ball {} has young_mod = 0 but the hill rule '{}' "
                                        "can apply to it; the hill model needs young_mod in (0, inf) [Pa]",
-                                       file_, sim.balls.id[i], r.name));
+                                       file_, sim.balls[i].id, r.name));
       }
     }
   }
 
-  void finish_box(Simulation& sim) {
+  void finish_box(SimulationDescription& sim) {
     if (!sim.settings.box.any()) return;
     if (!box_given_)
       throw InputError(file_ + ": key 'simulation.periodic' needs simulation.box_min and box_max [m] (or a [[packing]] LAMMPS file with a box)");
     for (std::size_t i = 0; i < sim.balls.size(); ++i)
-      if (!std::isfinite(norm(sim.balls.position[i])))
-        throw InputError(file_ + ": ball " + std::to_string(sim.balls.id[i]) + " has a non-finite position");
+      if (!std::isfinite(norm(sim.balls[i].position)))
+        throw InputError(file_ + ": ball " + std::to_string(sim.balls[i].id) + " has a non-finite position");
   }
 
   void motion_keys(TableReader& t, Wall& w) {
@@ -429,7 +426,7 @@ class Reader {
     w.spin = t.vec3("spin", Vec3{}, Range::any(), "[rad/s]");
   }
 
-  void read_wall(TableReader& t, Simulation& sim) {
+  void read_wall(TableReader& t, SimulationDescription& sim) {
     Wall w;
     w.name = t.string("name", std::nullopt);
     if (w.name.empty()) t.fail("name", "must not be empty");
@@ -473,12 +470,12 @@ class Reader {
       return;
     }
     t.finish();
-    sim.walls.add(w);
+    sim.walls.push_back(w);
   }
 
   // A box of 12 facets (2 per face) named <name>.<face>.<1|2>, each in the groups <name> and
   // <name>.<face> (faces xmin, xmax, ymin, ymax, zmin, zmax), so `wall = "box.zmin"` sums the floor.
-  void read_box(TableReader& t, Simulation& sim, const Wall& base) {
+  void read_box(TableReader& t, SimulationDescription& sim, const Wall& base) {
     const Vec3 lo = t.vec3("min", std::nullopt, Range::any(), "[m]");
     const Vec3 hi = t.vec3("max", std::nullopt, Range::any(), "[m]");
     if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z)) t.fail("max", "must exceed min in x, y and z");
@@ -504,21 +501,21 @@ class Reader {
         w.vertex[1] = half == 0 ? c[1] : c[2];
         w.vertex[2] = half == 0 ? c[2] : c[3];
         w.rotation_center = (lo + hi) / 2.0;
-        sim.walls.add(w);
+        sim.walls.push_back(w);
       }
     }
   }
 
-  std::uint64_t group_filter(TableReader& t, const std::string& g, Simulation& sim, const std::string& key) {
+  std::uint64_t group_filter(TableReader& t, const std::string& g, SimulationDescription& sim, const std::string& key) {
     if (g == "any") return 0;
     const std::uint64_t bit = sim.groups.find(g);
     if (!bit) t.fail(key, "no ball or wall is in group \"" + g + "\"");
     return bit;
   }
 
-  void read_rule(TableReader& t, Simulation& sim) {
+  void read_rule(TableReader& t, SimulationDescription& sim) {
     ModelRule r;
-    r.name = t.string("name", "rule " + std::to_string(sim.table.rules.size() + 1));
+    r.name = t.string("name", "rule " + std::to_string(sim.rules.size() + 1));
     const std::string between = t.choice("between", std::nullopt, {"ball-ball", "ball-wall"});
     r.kind = between == "ball-ball" ? ContactKind::BallBall : ContactKind::BallWall;
     const auto groups = t.strings("groups");
@@ -546,11 +543,11 @@ class Reader {
       r.linear.fric = t.real("fric", 0.0, Range::closed(0.0, kInf), "[-]");
     }
     t.finish();
-    if (sim.table.rules.size() >= 30000) t.fail("name", "at most 30000 assignment rules");
-    sim.table.rules.push_back(r);
+    if (sim.rules.size() >= 30000) t.fail("name", "at most 30000 assignment rules");
+    sim.rules.push_back(r);
   }
 
-  void read_history(TableReader& t, Scenario& sc) {
+  void read_history(TableReader& t, ScenarioDescription& sc) {
     History h;
     h.name = t.string("name", std::nullopt);
     if (h.name.empty() || h.name.find_first_of(",\"\n") != std::string::npos)
@@ -564,7 +561,7 @@ class Reader {
     sc.histories.push_back(h);
   }
 
-  Selection read_selection(TableReader& t, const Simulation& sim, bool walls_allowed) {
+  Selection read_selection(TableReader& t, const SimulationDescription& sim, bool walls_allowed) {
     Selection s;
     const int given = t.has("ball") + t.has("balls") + t.has("group") + (walls_allowed && t.has("wall"));
     const std::string keys = walls_allowed ? "ball, balls, group or wall" : "ball, balls or group";
@@ -572,9 +569,9 @@ class Reader {
     if (t.has("ball") || t.has("balls")) {
       const auto ids = t.has("ball") ? t.integers("ball") : t.integers("balls");
       for (std::int64_t id : ids) {
-        const long i = sim.balls.find(id);
-        if (i < 0) t.fail(t.has("ball") ? "ball" : "balls", "no ball with id " + std::to_string(id));
-        s.balls.push_back(static_cast<std::size_t>(i));
+        const auto i = ids_.find(id);
+        if (i == ids_.end()) t.fail(t.has("ball") ? "ball" : "balls", "no ball with id " + std::to_string(id));
+        s.balls.push_back(i->second);
       }
       if (s.balls.empty()) t.fail("balls", "must list at least one ball id");
       s.text = "ball(s) " + fmt::format("{}", fmt::join(ids, ","));
@@ -582,27 +579,25 @@ class Reader {
       const std::string g = t.string("group", std::nullopt);
       const std::uint64_t bit = sim.groups.find(g);
       for (std::size_t i = 0; i < sim.balls.size(); ++i)
-        if (bit && (sim.balls.groups[i] & bit)) s.balls.push_back(i);
+        if (bit && (sim.balls[i].groups & bit)) s.balls.push_back(i);
       if (s.balls.empty()) t.fail("group", "no ball is in group \"" + g + "\"");
       s.text = "group " + g;
     } else {
       const std::string w = t.string("wall", std::nullopt);
-      const std::uint64_t bit = sim.groups.find(w);
-      for (std::size_t k = 0; k < sim.walls.size(); ++k)
-        if (sim.walls.walls[k].name == w || (bit && (sim.walls.walls[k].groups & bit))) s.walls.push_back(k);
+      s.walls = sim.walls_named(w);
       if (s.walls.empty()) t.fail("wall", "no wall named or grouped \"" + w + "\"");
       s.text = "wall " + w;
     }
     return s;
   }
 
-  void read_stage(TableReader& t, Scenario& sc) {
+  void read_stage(TableReader& t, ScenarioDescription& sc) {
     Stage s;
     const std::string type = t.choice("type", std::nullopt,
                                       {"cycle", "solve", "translate", "rotate", "set", "set_contacts",
                                        "set_simulation", "make_wet", "make_dry", "probe", "list_contacts", "set_servo"});
     s.name = t.string("name", type == "probe" && t.is_string("label") ? *t.peek_string("label") : type);
-    const Simulation& sim = sc.sim;
+    const SimulationDescription& sim = sc.sim;
     if (type == "cycle") {
       s.type = StageType::Cycle;
       s.steps = t.integer("steps", std::nullopt, 1, 1'000'000'000'000);
@@ -696,27 +691,27 @@ class Reader {
   std::string file_;
   ScenarioLimits limits_;
   std::map<std::string, Material> materials_;
-  std::set<std::int64_t> ids_;
+  std::map<std::int64_t, std::size_t> ids_;  // ball id -> index
   std::set<std::string> wall_names_, labels_;
   bool box_given_ = false;
 };
 
 }  // namespace
 
-int Scenario::find_servo(const std::string& name) const {
+int ScenarioPlan::find_servo(const std::string& name) const {
   for (std::size_t k = 0; k < servos.size(); ++k)
     if (servos[k].name == name) return static_cast<int>(k);
   return -1;
 }
 
-Scenario load_scenario(const std::string& text, const std::string& file, const ScenarioLimits& limits) {
+ScenarioDescription read_scenario(const std::string& text, const std::string& file, const ScenarioLimits& limits) {
   const toml::table root = parse_toml(text, file);
-  Scenario sc = Reader(root, file, limits).read();
+  ScenarioDescription sc = Reader(root, file, limits).read();
   sc.text = text;
   return sc;
 }
 
-Scenario load_scenario_file(const std::string& path) {
+ScenarioDescription read_scenario_file(const std::string& path) {
   std::error_code ec;
   if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
     throw InputError(path + ": not a regular file");
@@ -724,7 +719,20 @@ Scenario load_scenario_file(const std::string& path) {
   if (!in) throw InputError(path + ": cannot open the scenario file");
   std::ostringstream ss;
   ss << in.rdbuf();
-  return load_scenario(ss.str(), path);
+  return read_scenario(ss.str(), path);
 }
+
+Scenario build_scenario(ScenarioDescription d) {
+  Scenario sc;
+  sc.sim = build_simulation(d.sim);
+  static_cast<ScenarioPlan&>(sc) = std::move(d);
+  return sc;
+}
+
+Scenario load_scenario(const std::string& text, const std::string& file, const ScenarioLimits& limits) {
+  return build_scenario(read_scenario(text, file, limits));
+}
+
+Scenario load_scenario_file(const std::string& path) { return build_scenario(read_scenario_file(path)); }
 
 }  // namespace hilldem

@@ -1,5 +1,7 @@
-// Scenario: a TOML file read into a ready Simulation plus the stages to run on it. Everything is
-// validated here, before any cycle runs (docs/scenario-format.md lists every key).
+// Scenario: a TOML file read into plain data (ScenarioDescription: the bodies, settings and rules as
+// a SimulationDescription, plus the stages, histories, servos and outputs), then built into a ready
+// Simulation (Scenario). Everything is validated by the reader, before anything is built or any
+// cycle runs (docs/scenario-format.md lists every key).
 #pragma once
 
 #include <cstdint>
@@ -10,6 +12,7 @@
 #include "hilldem/control/servo.hpp"
 #include "hilldem/engine/simulation.hpp"
 #include "hilldem/io/quantity.hpp"
+#include "hilldem/io/simulation_description.hpp"
 
 namespace hilldem {
 
@@ -92,11 +95,11 @@ struct ScenarioLimits {
   std::uint64_t max_balls = 50'000'000;  // as the reader's own guard
 };
 
-struct Scenario {
+// What a scenario does with its bodies: the stages, histories, servos and outputs.
+struct ScenarioPlan {
   std::string file;
   std::string text;  // the TOML source (checkpoints carry it, so a run resumes without the file)
   std::string title;
-  Simulation sim;
   std::vector<Stage> stages;
   std::vector<History> histories;
   std::int64_t history_every = 1;
@@ -110,7 +113,22 @@ struct Scenario {
   int find_servo(const std::string& name) const;
 };
 
+// A scenario as read: its plan and the description of its Simulation, nothing built yet.
+struct ScenarioDescription : ScenarioPlan {
+  SimulationDescription sim;
+};
+
+// A scenario ready to run: its plan and the Simulation built from its description.
+struct Scenario : ScenarioPlan {
+  Simulation sim;
+};
+
 // Parse and validate; `file` names the source in error messages. Throws InputError.
+ScenarioDescription read_scenario(const std::string& text, const std::string& file, const ScenarioLimits& limits = {});
+ScenarioDescription read_scenario_file(const std::string& path);
+// The plan as it is and the Simulation built from the description (build_simulation).
+Scenario build_scenario(ScenarioDescription d);
+// read_scenario (or read_scenario_file), then build_scenario.
 Scenario load_scenario(const std::string& text, const std::string& file, const ScenarioLimits& limits = {});
 Scenario load_scenario_file(const std::string& path);
 

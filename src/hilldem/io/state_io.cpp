@@ -186,17 +186,6 @@ SimulationSettings read_settings(SectionReader& r) {
 
 // ---- groups and table ----
 
-std::vector<std::string> group_names(const GroupNames& g) {
-  std::vector<std::string> names;
-  for (int k = 0; k < 64; ++k) {
-    const std::uint64_t bit = std::uint64_t{1} << k;
-    const std::string name = g.describe(bit);
-    if (g.find(name) != bit) break;
-    names.push_back(name);
-  }
-  return names;
-}
-
 void write_rule(SectionWriter& w, const ModelRule& r) {
   w.str(r.name);
   w.u8(static_cast<std::uint8_t>(r.kind));

@@ -156,17 +156,6 @@ std::vector<Array> time_fields(const Simulation& sim) {
   return {make_array("TimeValue", std::vector<double>{sim.time}), make_array("step", std::vector<std::int64_t>{sim.steps})};
 }
 
-std::vector<std::string> group_names(const GroupNames& g) {
-  std::vector<std::string> names;
-  for (int k = 0; k < 64; ++k) {
-    const std::uint64_t bit = std::uint64_t{1} << k;
-    const std::string name = g.describe(bit);
-    if (g.find(name) != bit) break;
-    names.push_back(name);
-  }
-  return names;
-}
-
 void save(const std::string& path, PolyFile& f) { write_file_atomically(path, f.xml(), false); }
 
 // Bounding box of the ball centres ± radii (a unit box around the origin when there are no balls).

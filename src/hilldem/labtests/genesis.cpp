@@ -13,6 +13,7 @@
 #include <ostream>
 #include <unordered_map>
 
+#include "hilldem/control/controller_scope.hpp"
 #include "hilldem/core/error.hpp"
 #include "hilldem/labtests/measure_region.hpp"
 
@@ -69,14 +70,6 @@ class PlacementGrid {
 void check_range(bool ok, const std::string& what, double value, const std::string& range) {
   if (!ok) throw InputError(fmt::format("{} must be {}, got {:g}", what, range, value));
 }
-
-// Removes the controllers it added when it goes out of scope (also on exceptions).
-struct ControllerScope {
-  Simulation& sim;
-  std::size_t before;
-  explicit ControllerScope(Simulation& s) : sim(s), before(s.controllers.size()) {}
-  ~ControllerScope() { sim.controllers.resize(before); }
-};
 
 }  // namespace
 

@@ -9,6 +9,7 @@
 #include <numbers>
 #include <ostream>
 
+#include "hilldem/control/controller_scope.hpp"
 #include "hilldem/core/error.hpp"
 
 namespace hilldem {
@@ -114,15 +115,6 @@ std::vector<LoopResult> LoopTracker::loops() const {
 
 // ---------------------------------------------------------------------------------------------------
 // The test
-
-namespace {
-struct ControllerScope {
-  Simulation& sim;
-  std::size_t before;
-  explicit ControllerScope(Simulation& s) : sim(s), before(s.controllers.size()) {}
-  ~ControllerScope() { sim.controllers.resize(before); }
-};
-}  // namespace
 
 TriaxialResult run_triaxial(Specimen& s, const TriaxialSettings& t, std::ostream* log) {
   validate(t);

@@ -1,0 +1,29 @@
+#include "hilldem/io/simulation_description.hpp"
+
+namespace hilldem {
+
+long SimulationDescription::find_ball(std::int64_t id) const {
+  for (std::size_t i = 0; i < balls.size(); ++i)
+    if (balls[i].id == id) return static_cast<long>(i);
+  return -1;
+}
+
+std::vector<std::size_t> SimulationDescription::walls_named(const std::string& name) const {
+  std::vector<std::size_t> out;
+  const std::uint64_t bit = groups.find(name);
+  for (std::size_t k = 0; k < walls.size(); ++k)
+    if (walls[k].name == name || (bit && (walls[k].groups & bit))) out.push_back(k);
+  return out;
+}
+
+Simulation build_simulation(const SimulationDescription& d) {
+  Simulation sim;
+  sim.settings = d.settings;
+  sim.groups = d.groups;
+  for (const BallInit& b : d.balls) sim.balls.add(b);
+  for (const Wall& w : d.walls) sim.walls.add(w);
+  sim.table.rules = d.rules;
+  return sim;
+}
+
+}  // namespace hilldem
