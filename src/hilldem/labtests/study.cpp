@@ -189,7 +189,7 @@ std::string StudyResult::summary_markdown() const {
          "and restores its friction (mu = 0.4). Each material is packed with its own model unless --pack-linear.\n"
          "Porosity: vessel = 1 − V_grains/(π R² H); interior = in the coaxial cylinder one D_max in from every wall (D50 where\n"
          "the vessel is too small for that: marked; n/a where even that leaves less than D_max in radius or 2 D_max in height).\n"
-         "Time: finalization, wetting and test of the case (wall clock); packing is done once per grading.\n";
+         "Time: finalization, wetting and test of the case (wall clock); packing is done once per grading and packing model.\n";
   const auto f = findings();
   if (!f.empty()) {
     out += "\nFindings of the memo, checked:\n\n";

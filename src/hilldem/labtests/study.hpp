@@ -60,7 +60,7 @@ struct CaseResult {
   GrainModel packed_with = GrainModel::Linear;  // grain-grain model of the packing it started from
   SpecimenState packed;                 // after packing (frictionless)
   SpecimenState initial;                // after finalization (and wetting): the test's start
-  std::vector<PhaseReport> phases;      // genesis phases of this case (packing shared by a grading)
+  std::vector<PhaseReport> phases;      // genesis phases of this case (packing shared by the cases of a grading and packing model)
   TriaxialResult test;
   double seconds = 0.0;                 // finalization + wetting + test, wall clock [s]
   double packing_seconds = 0.0;         // the packing it started from (shared by the cases of a grading) [s]
