@@ -81,7 +81,7 @@ add_test(NAME cli.triaxial_miniature_case_exits_0
 # vessel scaled by 0.15 (25 mm x 36 mm, about 45 grains of 5.6-8 mm): not even D50 fits, "n/a";
 # packed with hill contacts (the default) and with --pack-linear.
 add_test(NAME cli.triaxial_small_vessel_prints_no_nan
-  COMMAND ${HILLDEM_EXPECT_EXIT} --not-stdout "nan" --stdout "n/a (vessel under" --stdout "| fine | hill |"
+  COMMAND ${HILLDEM_EXPECT_EXIT} --not-stdout "nan" --stdout "n/a (vessel radius under D_max + D50" --stdout "| fine | hill |"
           --stdout "packing contacts hill with friction 0"
           0 $<TARGET_FILE:hilldem> triaxial --pack-only --grading ${HILLDEM_TEST_DATA}/labtests/fine.csv --scale 0.15
             --seed 42 --threads 1 -o ${HILLDEM_TRIAXIAL_OUT}/small_hill)

@@ -114,7 +114,7 @@ std::string interior_text(const SpecimenState& s) {
     case SpecimenState::Margin::D50: return fmt::format("{:.4f} (D50 margin)", s.interior_porosity);
     case SpecimenState::Margin::None: break;
   }
-  return "n/a (vessel under 2 D_max + D50 across)";
+  return "n/a (vessel radius under D_max + D50 or height under 2 (D_max + D50))";
 }
 
 double volume_median_diameter(std::vector<double> d) {

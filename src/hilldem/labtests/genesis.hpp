@@ -101,7 +101,8 @@ struct Specimen {
 // for frequent records.
 SpecimenState measure(const Specimen& s, bool interior = true);
 // The interior porosity as printed: "0.3072" with the D_max margin, "0.3301 (D50 margin)" with the
-// smaller one, "n/a (vessel under 2 D_max + D50 across)" when it cannot be measured. Never "nan".
+// smaller one, "n/a (vessel radius under D_max + D50 or height under 2 (D_max + D50))" when it cannot
+// be measured. Never "nan".
 std::string interior_text(const SpecimenState& s);
 // The volume-median diameter D50 of a set of diameters [m] (0 for none).
 double volume_median_diameter(std::vector<double> diameters);
