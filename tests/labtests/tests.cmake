@@ -89,7 +89,13 @@ add_test(NAME cli.triaxial_pack_linear_packs_with_linear_contacts
   COMMAND ${HILLDEM_EXPECT_EXIT} --not-stdout "nan" --stdout "| fine | linear |" --stdout "packing contacts linear with friction 0"
           0 $<TARGET_FILE:hilldem> triaxial --pack-only --pack-linear --grading ${HILLDEM_TEST_DATA}/labtests/fine.csv
             --scale 0.15 --seed 42 --threads 1 -o ${HILLDEM_TRIAXIAL_OUT}/small_linear)
-set_tests_properties(cli.triaxial_nan_packing_pressure_exits_2 cli.triaxial_inf_packing_pressure_exits_2
+# A confinement apart from the packing pressure: the finalized miniature specimen is brought to it, then tested at it.
+add_test(NAME cli.triaxial_confinement_apart_from_packing_pressure_exits_0
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stdout "confine fine_Hill" --stdout "triaxial: confinement 100 kPa" --not-stdout "nan"
+          0 $<TARGET_FILE:hilldem> triaxial --specimen ${HILLDEM_TEST_DATA}/labtests/mini_packed.csv
+            --grading ${HILLDEM_TEST_DATA}/labtests/fine.csv --confinement 100e3 --packing-pressure 150e3 --cycles 0.02
+            --final-strain 0.04 --strain-rate 0.1 --final-strain-rate 0.5 --threads 1 --no-plot -o ${HILLDEM_TRIAXIAL_OUT}/confine)
+set_tests_properties(cli.triaxial_confinement_apart_from_packing_pressure_exits_0 cli.triaxial_nan_packing_pressure_exits_2 cli.triaxial_inf_packing_pressure_exits_2
   cli.triaxial_zero_confinement_exits_2 cli.triaxial_nan_confinement_exits_2 cli.triaxial_negative_inf_confinement_exits_2
   cli.triaxial_pressure_option_is_gone_exits_2 cli.triaxial_pack_linear_with_specimen_exits_2
   cli.triaxial_small_vessel_prints_no_nan cli.triaxial_pack_linear_packs_with_linear_contacts
