@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <chrono>
 #include <ctime>
+#include <cmath>
 #include <cstdlib>
+#include <utility>
 #include <filesystem>
 #include <iostream>
 #include <sstream>
@@ -34,7 +36,9 @@ struct Options {
   bool full = false;
   double scale = kDefaultScale;
   std::int64_t seed = 10000;
-  double pressure = 150e3;
+  double packing_pressure = 150e3;  // P_m [Pa]
+  double confinement = 150e3;       // σ_c [Pa]
+  bool pack_linear = false;
   std::vector<double> cycles{0.02, 0.05};  // [%]
   double final_strain = 1.0;                // [%]
   double strain_rate = TriaxialSettings{}.strain_rate;              // [1/s]
@@ -70,11 +74,14 @@ std::pair<StudySettings, std::vector<CaseSpec>> build(const Options& o) {
   s.genesis.d_mult = o.d_mult;
   if (o.seed < 0) throw InputError(fmt::format("--seed must be >= 0, got {}", o.seed));
   s.genesis.packing.seed = static_cast<std::uint64_t>(o.seed);
-  if (!(o.pressure > 0)) throw InputError(fmt::format("--pressure must be > 0 Pa, got {:g}", o.pressure));
-  s.genesis.packing.equilibrium.pressure = o.pressure;
+  for (const auto& [name, value] : {std::pair{"--packing-pressure", o.packing_pressure}, std::pair{"--confinement", o.confinement}})
+    if (!(value > 0) || !std::isfinite(value))
+      throw InputError(fmt::format("{} must be a finite number > 0 Pa, got {:g}", name, value));
+  s.genesis.packing.equilibrium.pressure = o.packing_pressure;
   s.finalize = s.genesis.packing.equilibrium;
   s.finalize.ratio = o.finalize_ratio;  // validated with the rest
-  s.triaxial.confinement = o.pressure;
+  s.triaxial.confinement = o.confinement;
+  s.pack_linear = o.pack_linear;
   s.triaxial.cycle_strains.clear();
   for (double c : o.cycles) s.triaxial.cycle_strains.push_back(c / 100.0);
   s.triaxial.final_strain = o.final_strain / 100.0;
@@ -183,7 +190,14 @@ Command add_triaxial_command(CLI::App& app) {
   cmd->add_flag("--full", o->full, "the memo's full 170 mm x 240 mm vessel (default: scaled by 0.5, 85 mm x 120 mm)");
   cmd->add_option("--scale", o->scale, "vessel size relative to the memo's 170 mm x 240 mm (default 0.5)");
   cmd->add_option("--seed", o->seed, "random seed of the grain cloud (default 10000, Table 7)");
-  cmd->add_option("--pressure", o->pressure, "packing pressure P_m and confinement [Pa] (default 150e3)");
+  cmd->add_option("--packing-pressure", o->packing_pressure,
+                  "packing pressure P_m [Pa]: packing, finalization and wetting (default 150e3, Table 7)");
+  cmd->add_option("--confinement", o->confinement,
+                  "confining pressure sigma_c of the triaxial test [Pa] (default 150e3); when it differs from P_m the "
+                  "specimen is first brought to it on every wall");
+  cmd->add_flag("--pack-linear", o->pack_linear,
+                "pack every material with frictionless linear contacts, one packing per grading (the former shared "
+                "packing; a deviation from the memo, which packs each material with its own model)");
   cmd->add_option("--cycles", o->cycles, "axial strains [%] at which load-unload cycles reverse, increasing (default 0.02,0.05)")
       ->delimiter(',');
   cmd->add_option("--final-strain", o->final_strain, "final axial strain [%] (default 1)");

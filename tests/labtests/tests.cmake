@@ -5,6 +5,7 @@ add_executable(hilldem_labtests_tests
   labtests/test_servo.cpp
   labtests/test_triaxial.cpp
   labtests/test_measure.cpp
+  labtests/test_genesis.cpp
 )
 target_link_libraries(hilldem_labtests_tests PRIVATE hilldem::core GTest::gtest_main)
 target_compile_definitions(hilldem_labtests_tests PRIVATE HILLDEM_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
@@ -18,9 +19,32 @@ set(HILLDEM_TRIAXIAL_OUT ${CMAKE_CURRENT_BINARY_DIR}/triaxial_cli_out)
 add_test(NAME cli.triaxial_unknown_grading_exits_2
   COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "unknown grading 'C5x'" --stderr "choose C5n, C5b" --not-stdout "cloud"
           2 $<TARGET_FILE:hilldem> triaxial --grading C5x -o ${HILLDEM_TRIAXIAL_OUT}/bad1)
-add_test(NAME cli.triaxial_negative_pressure_exits_2
-  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "--pressure must be > 0 Pa, got -150000" --not-stdout "cloud"
-          2 $<TARGET_FILE:hilldem> triaxial --pressure=-150e3 -o ${HILLDEM_TRIAXIAL_OUT}/bad2)
+add_test(NAME cli.triaxial_negative_packing_pressure_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "--packing-pressure must be a finite number > 0 Pa, got -150000" --not-stdout "cloud"
+          2 $<TARGET_FILE:hilldem> triaxial --packing-pressure=-150e3 -o ${HILLDEM_TRIAXIAL_OUT}/bad2)
+add_test(NAME cli.triaxial_nan_packing_pressure_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "--packing-pressure must be a finite number > 0 Pa, got nan" --not-stdout "cloud"
+          2 $<TARGET_FILE:hilldem> triaxial --packing-pressure nan -o ${HILLDEM_TRIAXIAL_OUT}/bad10)
+add_test(NAME cli.triaxial_inf_packing_pressure_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "--packing-pressure must be a finite number > 0 Pa, got inf" --not-stdout "cloud"
+          2 $<TARGET_FILE:hilldem> triaxial --packing-pressure inf -o ${HILLDEM_TRIAXIAL_OUT}/bad11)
+add_test(NAME cli.triaxial_zero_confinement_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "--confinement must be a finite number > 0 Pa, got 0" --not-stdout "cloud"
+          2 $<TARGET_FILE:hilldem> triaxial --confinement 0 -o ${HILLDEM_TRIAXIAL_OUT}/bad12)
+add_test(NAME cli.triaxial_nan_confinement_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "--confinement must be a finite number > 0 Pa, got nan" --not-stdout "cloud"
+          2 $<TARGET_FILE:hilldem> triaxial --confinement nan -o ${HILLDEM_TRIAXIAL_OUT}/bad13)
+add_test(NAME cli.triaxial_negative_inf_confinement_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "--confinement must be a finite number > 0 Pa, got -inf" --not-stdout "cloud"
+          2 $<TARGET_FILE:hilldem> triaxial --confinement=-inf -o ${HILLDEM_TRIAXIAL_OUT}/bad14)
+# --pressure (packing pressure and confinement at once) is gone: refused like any unknown option.
+add_test(NAME cli.triaxial_pressure_option_is_gone_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "--pressure" --not-stdout "cloud"
+          2 $<TARGET_FILE:hilldem> triaxial --pressure 150e3 -o ${HILLDEM_TRIAXIAL_OUT}/bad15)
+add_test(NAME cli.triaxial_pack_linear_with_specimen_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "--pack-linear and --specimen"
+          2 $<TARGET_FILE:hilldem> triaxial --pack-linear --specimen ${HILLDEM_TEST_DATA}/labtests/mini_packed.csv
+            --grading ${HILLDEM_TEST_DATA}/labtests/fine.csv -o ${HILLDEM_TRIAXIAL_OUT}/bad16)
 add_test(NAME cli.triaxial_cycles_out_of_order_exits_2
   COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "cycle strains must be positive and increasing" --not-stdout "cloud"
           2 $<TARGET_FILE:hilldem> triaxial --cycles 0.05,0.02 -o ${HILLDEM_TRIAXIAL_OUT}/bad3)
@@ -53,7 +77,30 @@ add_test(NAME cli.triaxial_miniature_case_exits_0
           0 $<TARGET_FILE:hilldem> triaxial --specimen ${HILLDEM_TEST_DATA}/labtests/mini_packed.csv
             --grading ${HILLDEM_TEST_DATA}/labtests/fine.csv --wet --cycles 0.02 --final-strain 0.1 --strain-rate 0.1
             --final-strain-rate 0.5 --threads 1 --no-plot -o ${HILLDEM_TRIAXIAL_OUT}/mini)
-set_tests_properties(cli.triaxial_unknown_grading_exits_2 cli.triaxial_negative_pressure_exits_2
+# Genesis only, in vessels too small for an interior measured one D_max in: never `nan`. The memo's
+# vessel scaled by 0.15 (25 mm x 36 mm, about 45 grains of 5.6-8 mm): not even D50 fits, "n/a";
+# packed with hill contacts (the default) and with --pack-linear.
+add_test(NAME cli.triaxial_small_vessel_prints_no_nan
+  COMMAND ${HILLDEM_EXPECT_EXIT} --not-stdout "nan" --stdout "n/a (vessel radius under D_max + D50" --stdout "| fine | hill |"
+          --stdout "packing contacts hill with friction 0"
+          0 $<TARGET_FILE:hilldem> triaxial --pack-only --grading ${HILLDEM_TEST_DATA}/labtests/fine.csv --scale 0.15
+            --seed 42 --threads 1 -o ${HILLDEM_TRIAXIAL_OUT}/small_hill)
+add_test(NAME cli.triaxial_pack_linear_packs_with_linear_contacts
+  COMMAND ${HILLDEM_EXPECT_EXIT} --not-stdout "nan" --stdout "| fine | linear |" --stdout "packing contacts linear with friction 0"
+          0 $<TARGET_FILE:hilldem> triaxial --pack-only --pack-linear --grading ${HILLDEM_TEST_DATA}/labtests/fine.csv
+            --scale 0.15 --seed 42 --threads 1 -o ${HILLDEM_TRIAXIAL_OUT}/small_linear)
+# A confinement apart from the packing pressure: the finalized miniature specimen is brought to it, then tested at it.
+add_test(NAME cli.triaxial_confinement_apart_from_packing_pressure_exits_0
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stdout "confine fine_Hill" --stdout "triaxial: confinement 100 kPa" --not-stdout "nan"
+          0 $<TARGET_FILE:hilldem> triaxial --specimen ${HILLDEM_TEST_DATA}/labtests/mini_packed.csv
+            --grading ${HILLDEM_TEST_DATA}/labtests/fine.csv --confinement 100e3 --packing-pressure 150e3 --cycles 0.02
+            --final-strain 0.04 --strain-rate 0.1 --final-strain-rate 0.5 --threads 1 --no-plot -o ${HILLDEM_TRIAXIAL_OUT}/confine)
+set_tests_properties(cli.triaxial_confinement_apart_from_packing_pressure_exits_0 cli.triaxial_nan_packing_pressure_exits_2 cli.triaxial_inf_packing_pressure_exits_2
+  cli.triaxial_zero_confinement_exits_2 cli.triaxial_nan_confinement_exits_2 cli.triaxial_negative_inf_confinement_exits_2
+  cli.triaxial_pressure_option_is_gone_exits_2 cli.triaxial_pack_linear_with_specimen_exits_2
+  cli.triaxial_small_vessel_prints_no_nan cli.triaxial_pack_linear_packs_with_linear_contacts
+  PROPERTIES TIMEOUT 120 LABELS "cli;labtests")
+set_tests_properties(cli.triaxial_unknown_grading_exits_2 cli.triaxial_negative_packing_pressure_exits_2
   cli.triaxial_cycles_out_of_order_exits_2 cli.triaxial_final_below_cycles_exits_2 cli.triaxial_wet_linear_exits_2
   cli.triaxial_unknown_material_exits_2 cli.triaxial_bad_grading_file_exits_2 cli.triaxial_missing_specimen_exits_2
   cli.triaxial_miniature_case_exits_0 cli.triaxial_refused_run_writes_nothing cli.triaxial_bad_density_scaling_exits_2

@@ -82,6 +82,13 @@ void validate(const GenesisSpec& s) {
   check_range(s.vessel_height > 0 && std::isfinite(s.vessel_height), "vessel height [m]", s.vessel_height, "> 0");
   check_range(p.cloud_porosity > 0 && p.cloud_porosity < 1, "cloud porosity", p.cloud_porosity, "in (0, 1)");
   check_range(p.local_damping >= 0 && p.local_damping < 1, "local damping", p.local_damping, "in [0, 1)");
+  check_range(p.contact.fric >= 0 && std::isfinite(p.contact.fric), "packing friction", p.contact.fric, ">= 0");
+  check_range(p.contact.damp_con >= 0 && p.contact.damp_con < 1, "packing hill damping", p.contact.damp_con, "in [0, 1)");
+  check_range(p.contact.emod > 0 && std::isfinite(p.contact.emod), "packing E* [Pa]", p.contact.emod, "> 0");
+  check_range(p.contact.kratio > 0 && std::isfinite(p.contact.kratio), "packing kratio", p.contact.kratio, "> 0");
+  check_range(s.grain.density > 0 && std::isfinite(s.grain.density), "grain density [kg/m3]", s.grain.density, "> 0");
+  check_range(s.grain.young_mod > 0 && std::isfinite(s.grain.young_mod), "grain Young's modulus [Pa]", s.grain.young_mod, "> 0");
+  check_range(s.grain.pois_ratio > -1 && s.grain.pois_ratio <= 0.5, "grain Poisson's ratio", s.grain.pois_ratio, "in (-1, 0.5]");
   check_range(e.pressure > 0 && std::isfinite(e.pressure), "pressure [Pa]", e.pressure, "> 0");
   check_range(e.pressure_tolerance > 0 && e.pressure_tolerance < 1, "pressure tolerance", e.pressure_tolerance, "in (0, 1)");
   check_range(e.ratio > 0 && e.ratio < 1, "equilibrium ratio", e.ratio, "in (0, 1)");
@@ -94,10 +101,32 @@ void validate(const GenesisSpec& s) {
                                  d_max * 1e3, 2e3 * s.vessel_radius, 1e3 * s.vessel_height));
 }
 
+std::string interior_text(const SpecimenState& s) {
+  switch (s.interior_margin) {
+    case SpecimenState::Margin::DMax: return fmt::format("{:.4f}", s.interior_porosity);
+    case SpecimenState::Margin::D50: return fmt::format("{:.4f} (D50 margin)", s.interior_porosity);
+    case SpecimenState::Margin::None: break;
+  }
+  return "n/a (vessel radius under D_max + D50 or height under 2 (D_max + D50))";
+}
+
+double volume_median_diameter(std::vector<double> d) {
+  if (d.empty()) return 0.0;
+  std::sort(d.begin(), d.end());
+  double total = 0.0;
+  for (double x : d) total += x * x * x;
+  double sum = 0.0;
+  for (double x : d) {
+    sum += x * x * x;
+    if (sum >= 0.5 * total) return x;
+  }
+  return d.back();
+}
+
 std::string PhaseReport::line() const {
-  return fmt::format("{:<22} {:>8} steps {:>7.1f} s  n {:.4f} (interior {:.4f})  Z {:.3f}  sigma_r {:.2f} kPa  sigma_bottom {:.2f} kPa  "
+  return fmt::format("{:<22} {:>8} steps {:>7.1f} s  n {:.4f} (interior {})  Z {:.3f}  sigma_r {:.2f} kPa  sigma_bottom {:.2f} kPa  "
                      "sigma_top {:.2f} kPa  ratio {:.2e}",
-                     name, steps, seconds, state.porosity, state.interior_porosity, state.coordination, state.radial_stress / 1e3,
+                     name, steps, seconds, state.porosity, interior_text(state), state.coordination, state.radial_stress / 1e3,
                      state.bottom_stress / 1e3, state.top_stress / 1e3, state.ratio);
 }
 
@@ -116,13 +145,29 @@ SpecimenState measure(const Specimen& s, bool interior) {
   st.radius = s.vessel.radius(sim);
   st.height = s.vessel.height(sim);
   st.porosity = 1.0 - solid / s.vessel.volume(sim);
-  double d_max = 0.0;
-  for (double r : sim.balls.radius) d_max = std::max(d_max, 2.0 * r);
-  const MeasurementCylinder region{st.radius - d_max, s.vessel.bottom_z(sim) + d_max, s.vessel.top_z(sim) - d_max};
-  // The region must hold at least one D_max across and two in height, else there is no interior.
-  st.interior_porosity = interior && region.radius >= d_max && region.z_hi - region.z_lo >= 2.0 * d_max
-                             ? region_porosity(region, sim.balls.position, sim.balls.radius)
-                             : std::numeric_limits<double>::quiet_NaN();
+  if (interior) {
+    double d_max = 0.0;
+    for (double r : sim.balls.radius) d_max = std::max(d_max, 2.0 * r);
+    // The region must hold at least one D_max in radius and two in height. Margin D_max from every
+    // wall; failing that (a small vessel) D50; failing that there is no interior to measure.
+    auto region = [&](double margin) {
+      return MeasurementCylinder{st.radius - margin, s.vessel.bottom_z(sim) + margin, s.vessel.top_z(sim) - margin};
+    };
+    auto fits = [&](const MeasurementCylinder& m) { return m.radius >= d_max && m.z_hi - m.z_lo >= 2.0 * d_max; };
+    st.interior_margin = SpecimenState::Margin::None;
+    st.interior_porosity = std::numeric_limits<double>::quiet_NaN();
+    if (d_max > 0.0 && fits(region(d_max))) {
+      st.interior_margin = SpecimenState::Margin::DMax;
+      st.interior_margin_length = d_max;
+    } else if (const double d50 = volume_median_diameter(s.diameters()); d50 > 0.0 && fits(region(d50))) {
+      st.interior_margin = SpecimenState::Margin::D50;
+      st.interior_margin_length = d50;
+    }
+    if (st.interior_margin != SpecimenState::Margin::None)
+      st.interior_porosity = region_porosity(region(st.interior_margin_length), sim.balls.position, sim.balls.radius);
+  } else {
+    st.interior_porosity = st.porosity;  // not measured: the vessel's
+  }
   std::vector<std::uint32_t> per_ball(st.grains, 0);
   std::size_t touching = 0;
   for (std::size_t c = 0; c < sim.contacts.size(); ++c) {
@@ -158,6 +203,7 @@ Specimen make_cloud(const GenesisSpec& spec) {
   s.d_mult = spec.d_mult;
   s.seed = p.seed;
   s.pressure = p.equilibrium.pressure;
+  s.packed_with = p.contact.model;
   Simulation& sim = s.sim;
   sim.settings.local_damping = p.local_damping;
   sim.settings.auto_timestep = true;
@@ -179,7 +225,7 @@ Specimen make_cloud(const GenesisSpec& spec) {
   std::vector<double> rad;
   pos.reserve(order.size());
   rad.reserve(order.size());
-  const Class5Material grain_defaults;  // granite until finalization sets the material
+  const Class5Material& grain_defaults = spec.grain;  // density, E, ν until finalization sets the material
   for (std::size_t i : order) {
     const double r = 0.5 * sample.diameters[i];
     Vec3 best;
@@ -293,9 +339,11 @@ Specimen pack_specimen(const GenesisSpec& spec, std::ostream* log) {
   const auto t0 = std::chrono::steady_clock::now();
   Specimen s = make_cloud(spec);
   if (log)
-    *log << fmt::format("cloud: {} grains of {} at porosity {:.3f} in a {:.0f} mm x {:.0f} mm vessel (seed {}, {:.1f} s)\n",
+    *log << fmt::format("cloud: {} grains of {} at porosity {:.3f} in a {:.0f} mm x {:.0f} mm vessel (seed {}, {:.1f} s); "
+                        "packing contacts {} with friction {:g}\n",
                         s.sim.balls.size(), spec.grading.name, measure(s).porosity, 2e3 * spec.vessel_radius,
-                        1e3 * spec.vessel_height, spec.packing.seed, seconds_since(t0));
+                        1e3 * spec.vessel_height, spec.packing.seed, seconds_since(t0), to_string(spec.packing.contact.model),
+                        spec.packing.contact.fric);
   relax_cloud(s, spec.packing, log);
   servo_equilibrium(s, spec.packing.equilibrium, "packing", log);
   return s;

@@ -1,7 +1,7 @@
 // Material genesis (docs/spec/lab-tests.md §3): a seeded random cloud of grains at porosity n_c in
 // the vessel, frictionless packing by boundary contraction under servo control to the material
-// pressure P_m, static equilibrium, finalization through the assignment table, and (optionally)
-// wetting. Every phase reports what it did and the state it reached.
+// pressure P_m (each material with its own contact model, μ_CA = 0), static equilibrium,
+// finalization through the assignment table (friction restored), and (optionally) wetting. Every phase reports what it did and the state it reached.
 #pragma once
 
 #include <cstdint>
@@ -36,7 +36,7 @@ struct PackingSettings {
   double cloud_overlap = 1e-3;       // relaxation ends when every overlap ≤ this × smallest diameter [ours]
   std::int64_t cloud_max_steps = 200'000;
   EquilibriumSettings equilibrium;   // P_m = 150 kPa, ε_P = 1e-2, ε_lim = 8e-3, v_lim = 1 m/s (Table 7)
-  PackingContact contact;            // frictionless linear packing contacts
+  PackingContact contact;            // frictionless packing contacts: hill by default, or linear
   WallContact walls;
 };
 
@@ -45,6 +45,9 @@ struct GenesisSpec {
   double d_mult = 1.0;               // D_mult (Table 7)
   double vessel_radius = 0.085;      // [m] (170 mm diameter)
   double vessel_height = 0.240;      // [m]
+  // The grains' density, E and ν from the cloud on (the hill packing contacts read E and ν); the
+  // material's model and friction are not used here (packing.contact says how grains are packed).
+  Class5Material grain;
   PackingSettings packing;
 };
 // Throws InputError naming the first bad value.
@@ -54,8 +57,14 @@ void validate(const GenesisSpec& spec);
 struct SpecimenState {
   std::size_t grains = 0;
   double porosity = 0.0;            // 1 − V_solid / (π R² H) [-]: the whole vessel
-  double interior_porosity = 0.0;   // in the coaxial cylinder one D_max in from every wall [-] (measure_region.hpp);
-                                    // NaN when that leaves less than D_max radius or 2 D_max height
+  // In a coaxial measurement cylinder one margin in from every wall [-] (measure_region.hpp). The
+  // margin is D_max; where that leaves less than D_max in radius or 2 D_max in height (the half-size
+  // vessels), it is D50, the grains' volume-median diameter; where even that leaves too little, the
+  // interior is not measured: interior_margin is None and interior_porosity NaN (never printed as
+  // such: interior_text() says "n/a" and why).
+  double interior_porosity = 0.0;
+  enum class Margin : std::uint8_t { DMax, D50, None } interior_margin = Margin::DMax;
+  double interior_margin_length = 0.0;  // the margin [m] (0 when None)
   double coordination = 0.0;        // 2 N_c / N_grains, touching grain-grain contacts [-]
   double mech_coordination = 0.0;   // Thornton's: grains with < 2 contacts left out [-]
   double radial_stress = 0.0;       // lateral wall [Pa]
@@ -82,6 +91,7 @@ struct Specimen {
   std::uint64_t seed = 0;
   double pressure = 0.0;               // P_m it was packed to [Pa]
   std::string material = "packed";     // what the assignment table holds: "packed", "C5b_Hill", ...
+  GrainModel packed_with = GrainModel::Linear;  // the grain-grain model of the packing contacts
   bool wet = false;
   std::vector<PhaseReport> phases;     // genesis history
   std::vector<double> diameters() const;
@@ -90,6 +100,12 @@ struct Specimen {
 // The specimen's state; `interior` false skips the measurement-cylinder porosity (set to the vessel's),
 // for frequent records.
 SpecimenState measure(const Specimen& s, bool interior = true);
+// The interior porosity as printed: "0.3072" with the D_max margin, "0.3301 (D50 margin)" with the
+// smaller one, "n/a (vessel radius under D_max + D50 or height under 2 (D_max + D50))" when it cannot
+// be measured. Never "nan".
+std::string interior_text(const SpecimenState& s);
+// The volume-median diameter D50 of a set of diameters [m] (0 for none).
+double volume_median_diameter(std::vector<double> diameters);
 
 // The cloud: grains sampled from the grading for porosity n_c in the vessel and placed at random
 // (best of placement_tries positions, largest grains first; overlaps allowed), packing table
@@ -101,11 +117,12 @@ PhaseReport relax_cloud(Specimen& s, const PackingSettings& p, std::ostream* log
 // Servo-controlled walls to P ± ε_P·P and mean unbalanced-force ratio ≤ ε_lim; walls stopped at the
 // end. Throws RunError after max_steps.
 PhaseReport servo_equilibrium(Specimen& s, const EquilibriumSettings& e, const std::string& name, std::ostream* log);
-// make_cloud + relax_cloud + servo_equilibrium: the packed (frictionless) specimen.
+// make_cloud + relax_cloud + servo_equilibrium: the packed (frictionless) specimen, packed with
+// spec.packing.contact (the material's own model by default).
 Specimen pack_specimen(const GenesisSpec& spec, std::ostream* log);
 
-// Finalization: grain properties and the material's assignment table installed on every contact,
-// then servo equilibrium at the specimen's P_m.
+// Finalization: grain properties and the material's assignment table installed on every contact
+// (friction μ restored), then servo equilibrium at e.pressure (P_m).
 PhaseReport finalize(Specimen& s, const Class5Material& m, const WallContact& walls, const EquilibriumSettings& e,
                      std::ostream* log);
 // Wet material (lab-tests.md §3.6): make_wet(ψ, g_m) on the finalized hill specimen, then servo

@@ -33,9 +33,14 @@ ModelRule grain_rule(Simulation& sim, const std::string& name) {
 
 ModelTable packing_table(Simulation& sim, const PackingContact& grains, const WallContact& walls) {
   ModelTable t;
-  ModelRule g = grain_rule(sim, "grain-grain packing");
-  g.model = ModelKind::Linear;
-  g.linear = LinearParams{grains.emod, grains.kratio, grains.fric};
+  ModelRule g = grain_rule(sim, grains.model == GrainModel::Hill ? "grain-grain packing hill" : "grain-grain packing linear");
+  if (grains.model == GrainModel::Hill) {
+    g.model = ModelKind::Hill;
+    g.hill = HillParams{grains.fric, grains.damp_con, 0.0};  // dry: no suction acts during packing
+  } else {
+    g.model = ModelKind::Linear;
+    g.linear = LinearParams{grains.emod, grains.kratio, grains.fric};
+  }
   t.rules.push_back(g);
   WallContact w = walls;
   w.fric = 0.0;  // frictionless walls during genesis [practice]

@@ -1,6 +1,7 @@
 // Class 5 materials of the memo (Table 7, docs/spec/hill-model.md §5.3) and the contact-model
-// assignment tables of genesis: the frictionless packing table, and the final table that installs
-// the material (hill or linear between grains, linear to the vessel walls).
+// assignment tables of genesis: the frictionless packing table (the material's own grain-grain model,
+// μ_CA = 0), and the final table that installs the material (hill or linear between grains, linear to
+// the vessel walls).
 #pragma once
 
 #include <cstdint>
@@ -35,13 +36,19 @@ struct WallContact {
   double fric = 0.0;    // μ [-]
 };
 
-// Contacts during packing [ours]: linear between grains with the linear material's stiffness
-// (E* = 500 MPa, κ* = 1.5) and the packing friction μ_CA (0), so that one packed specimen serves
-// both materials; finalization installs the material's own model.
+// Grain-grain contacts during packing (lab-tests.md §3.2): each material is packed with its own
+// model at the packing friction μ_CA = 0 (Table 7) — hill contacts between hill grains (Hertz from
+// the grains' E and ν, damping γ_h, dry), linear contacts (E*, κ*) between linear grains.
+// Finalization then installs the material's table, which restores the friction μ. The shared
+// linear packing of earlier versions (both materials packed with linear contacts, one packed
+// specimen per grading) is `model = GrainModel::Linear` for either material: a deviation from the
+// memo, kept as an option (StudySettings::pack_linear, `hilldem triaxial --pack-linear`).
 struct PackingContact {
-  double emod = 500e6;  // E* [Pa]
-  double kratio = 1.5;  // κ* [-]
-  double fric = 0.0;    // μ_CA [-]
+  GrainModel model = GrainModel::Hill;  // grain-grain model during packing
+  double emod = 500e6;   // E* [Pa] (linear)
+  double kratio = 1.5;   // κ* [-] (linear)
+  double damp_con = 0.0; // γ_h [-] (hill)
+  double fric = 0.0;     // μ_CA [-]
 };
 
 // Group names used by the tables: every grain is in "grain", the vessel walls in "vessel".

@@ -29,8 +29,8 @@ std::string packed_specimen_text(const Specimen& s, const PackingSettings& p) {
     throw InputError("only a packed specimen (before finalization) can be saved: its state is exact without contact history");
   const Simulation& sim = s.sim;
   std::string out;
-  out += "# hilldem packed specimen: frictionless packing by boundary contraction; positions and radii\n";
-  out += "# reproduce every contact force of the packing contacts. `hilldem triaxial --specimen FILE` starts here.\n";
+  out += "# hilldem packed specimen: frictionless packing by boundary contraction; positions, radii and grain\n";
+  out += "# properties reproduce every contact force of the packing contacts. `hilldem triaxial --specimen FILE` starts here.\n";
   out += fmt::format("format,{},{}\n", kMagic, kVersion);
   out += fmt::format("grading,{}\n", s.grading);
   out += fmt::format("d_mult,{}\n", s.d_mult);
@@ -40,6 +40,8 @@ std::string packed_specimen_text(const Specimen& s, const PackingSettings& p) {
   out += fmt::format("vessel_radius[m],{}\n", s.vessel.radius(sim));
   out += fmt::format("vessel_bottom[m],{}\n", s.vessel.bottom_z(sim));
   out += fmt::format("vessel_top[m],{}\n", s.vessel.top_z(sim));
+  out += fmt::format("packing_model,{}\n", to_string(s.packed_with));
+  out += fmt::format("packing_damp_con,{}\n", p.contact.damp_con);
   out += fmt::format("packing_emod[Pa],{}\n", p.contact.emod);
   out += fmt::format("packing_kratio,{}\n", p.contact.kratio);
   out += fmt::format("packing_fric,{}\n", p.contact.fric);
@@ -137,6 +139,19 @@ Specimen parse_packed_specimen(const std::string& text, const std::string& sourc
   s.seed = static_cast<std::uint64_t>(number("seed", false));
   s.pressure = number("pressure[Pa]", true);
   PackingSettings p;
+  // packing_model and packing_damp_con are absent from the files written before each material was
+  // packed with its own model: those specimens were packed with linear contacts.
+  p.contact.model = GrainModel::Linear;
+  if (keys.count("packing_model")) {
+    const auto [m, at] = get("packing_model");
+    if (m == "hill") p.contact.model = GrainModel::Hill;
+    else if (m != "linear") throw fail(at, "packing_model must be linear or hill, got '" + m + "'");
+  }
+  if (keys.count("packing_damp_con")) {
+    p.contact.damp_con = number("packing_damp_con", false);
+    if (p.contact.damp_con >= 1) throw fail(get("packing_damp_con").second, "packing_damp_con must be below 1");
+  }
+  s.packed_with = p.contact.model;
   p.contact.emod = number("packing_emod[Pa]", true);
   p.contact.kratio = number("packing_kratio", true);
   p.contact.fric = number("packing_fric", false);

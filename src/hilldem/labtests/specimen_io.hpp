@@ -1,7 +1,9 @@
 // Saved packed specimens: the state at the end of frictionless packing (before finalization), as a
-// text file of settings and `id,x,y,z,radius` rows. Contact forces of the packing contacts are
-// functions of the positions alone (linear, frictionless), so a loaded specimen is the saved one:
-// finalization, wetting and tests can start from it without repacking.
+// text file of settings and `id,x,y,z,radius,...` rows. Contact forces of the packing contacts are
+// functions of the positions and grain properties alone (linear or hill, frictionless, no dashpot
+// with the default γ_h = 0), so a loaded specimen is the saved one: finalization, wetting and tests
+// can start from it without repacking. The file says which model packed it (`packing_model`;
+// files without that key were packed with linear contacts).
 #pragma once
 
 #include <string>

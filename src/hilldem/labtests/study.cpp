@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <ctime>
 #include <exception>
 #include <filesystem>
@@ -58,6 +59,8 @@ void validate(const StudySettings& s, const std::vector<CaseSpec>& cases) {
     if (c.wet && c.model != GrainModel::Hill)
       throw InputError("--wet needs the hill material: the linear model has no liquid bridges");
   }
+  if (s.pack_linear && !s.specimen_file.empty())
+    throw InputError("--pack-linear and --specimen: the specimen file says which contacts packed it");
   const EquilibriumSettings& e = s.finalize;
   if (!(e.pressure > 0) || !std::isfinite(e.pressure)) throw InputError(fmt::format("pressure must be > 0 Pa, got {:g}", e.pressure));
   if (!(e.ratio > 0 && e.ratio < 1)) throw InputError(fmt::format("equilibrium ratio must be in (0, 1), got {:g}", e.ratio));
@@ -87,9 +90,9 @@ void write_file(const fs::path& p, const std::string& text) {
 }
 
 std::string state_text(const char* label, const SpecimenState& s) {
-  return fmt::format("{}: grains {}, porosity {:.4f} (interior {:.4f}), coordination {:.3f} (mechanical {:.3f}), sigma_r {:.2f} kPa, "
+  return fmt::format("{}: grains {}, porosity {:.4f} (interior {}), coordination {:.3f} (mechanical {:.3f}), sigma_r {:.2f} kPa, "
                      "sigma_bottom {:.2f} kPa, sigma_top {:.2f} kPa, R {:.3f} mm, H {:.3f} mm, wet contacts {}, ratio {:.2e}\n",
-                     label, s.grains, s.porosity, s.interior_porosity, s.coordination, s.mech_coordination, s.radial_stress / 1e3,
+                     label, s.grains, s.porosity, interior_text(s), s.coordination, s.mech_coordination, s.radial_stress / 1e3,
                      s.bottom_stress / 1e3, s.top_stress / 1e3, s.radius * 1e3, s.height * 1e3, s.wet_contacts, s.ratio);
 }
 
@@ -104,6 +107,11 @@ std::string loops_csv(const std::vector<LoopResult>& loops) {
   return out;
 }
 
+// A CSV cell of the interior porosity: empty when it could not be measured.
+std::string interior_cell(const SpecimenState& s) {
+  return s.interior_margin == SpecimenState::Margin::None ? std::string() : fmt::format("{:.6g}", s.interior_porosity);
+}
+
 std::size_t max_loops(const std::vector<CaseResult>& cases) {
   std::size_t n = 0;
   for (const CaseResult& c : cases) n = std::max(n, c.test.loops.size());
@@ -115,8 +123,8 @@ std::size_t max_loops(const std::vector<CaseResult>& cases) {
 std::string StudyResult::summary_csv() const {
   const std::size_t nl = max_loops(cases);
   std::string out =
-      "case,grading,material,wet,grains,porosity_packed[-],interior_porosity_packed[-],porosity_test_start[-],"
-      "interior_porosity_test_start[-],coordination_test_start[-],"
+      "case,grading,material,wet,packing_model,grains,porosity_packed[-],interior_porosity_packed[-],interior_margin_packed[m],"
+      "porosity_test_start[-],interior_porosity_test_start[-],coordination_packed[-],coordination_test_start[-],"
       "sigma_r_start[Pa],sigma_axial_start[Pa],peak_q[Pa],peak_eps_a[-]";
   for (std::size_t k = 1; k <= nl; ++k)
     out += fmt::format(",eps_A_cycle{0}[-],Mr_unload_secant_cycle{0}[Pa],reload_secant_cycle{0}[Pa],loop_area_cycle{0}[J/m3],"
@@ -124,9 +132,10 @@ std::string StudyResult::summary_csv() const {
                        k);
   out += ",worst_confinement_error[-],worst_platen_mismatch[-],test_steps,packing_seconds,seconds\n";
   for (const CaseResult& c : cases) {
-    out += fmt::format("{},{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.9g},{:.9g},{:.9g},{:.6g}", c.spec.name(),
-                       c.grading.name, to_string(c.spec.model), c.spec.wet ? 1 : 0, c.initial.grains, c.packed.porosity,
-                       c.packed.interior_porosity, c.initial.porosity, c.initial.interior_porosity, c.initial.coordination, c.initial.radial_stress,
+    out += fmt::format("{},{},{},{},{},{},{:.6g},{},{:.6g},{:.6g},{},{:.6g},{:.6g},{:.9g},{:.9g},{:.9g},{:.6g}", c.spec.name(),
+                       c.grading.name, to_string(c.spec.model), c.spec.wet ? 1 : 0, to_string(c.packed_with), c.initial.grains,
+                       c.packed.porosity, interior_cell(c.packed), c.packed.interior_margin_length, c.initial.porosity,
+                       interior_cell(c.initial), c.packed.coordination, c.initial.coordination, c.initial.radial_stress,
                        0.5 * (c.initial.bottom_stress + c.initial.top_stress), c.test.peak_q, c.test.peak_strain);
     for (std::size_t k = 0; k < nl; ++k) {
       if (k < c.test.loops.size()) {
@@ -145,8 +154,10 @@ std::string StudyResult::summary_csv() const {
 
 std::string StudyResult::summary_markdown() const {
   const std::size_t nl = max_loops(cases);
-  std::string head = "| case | grains | porosity packed: vessel / interior | at test start: vessel / interior | Z | peak q [kPa] | at eps_a [%] |";
-  std::string rule = "|---|---:|---:|---:|---:|---:|---:|";
+  std::string head =
+      "| case | packed with | grains | porosity packed: vessel / interior | at test start: vessel / interior | Z packed | Z | "
+      "peak q [kPa] | at eps_a [%] |";
+  std::string rule = "|---|---|---:|---:|---:|---:|---:|---:|---:|";
   for (std::size_t k = 1; k <= nl; ++k) {
     head += fmt::format(" M_r c{0} [MPa] | reload c{0} [MPa] | loop c{0} [J/m³] |", k);
     rule += "---:|---:|---:|";
@@ -155,9 +166,10 @@ std::string StudyResult::summary_markdown() const {
   rule += "---:|---:|---:|---:|";
   std::string out = head + "\n" + rule + "\n";
   for (const CaseResult& c : cases) {
-    out += fmt::format("| {} | {} | {:.4f} / {:.4f} | {:.4f} / {:.4f} | {:.2f} | {:.1f} | {:.3f} |", c.spec.name(), c.initial.grains,
-                       c.packed.porosity, c.packed.interior_porosity, c.initial.porosity, c.initial.interior_porosity,
-                       c.initial.coordination, c.test.peak_q / 1e3, 100 * c.test.peak_strain);
+    out += fmt::format("| {} | {} | {} | {:.4f} / {} | {:.4f} / {} | {:.2f} | {:.2f} | {:.1f} | {:.3f} |", c.spec.name(),
+                       to_string(c.packed_with), c.initial.grains, c.packed.porosity, interior_text(c.packed), c.initial.porosity,
+                       interior_text(c.initial), c.packed.coordination, c.initial.coordination, c.test.peak_q / 1e3,
+                       100 * c.test.peak_strain);
     for (std::size_t k = 0; k < nl; ++k) {
       if (k < c.test.loops.size()) {
         const LoopResult& l = c.test.loops[k];
@@ -171,9 +183,13 @@ std::string StudyResult::summary_markdown() const {
                        c.test.steps, c.seconds);
   }
   out += "\nM_r: resilient modulus, unload secant (q_A − q_B)/(eps_A − eps_B); reload: reload secant (q_C − q_B)/(eps_A − eps_B);\n"
-         "loop: hysteresis, loop area ∮ q d(eps_a) = energy dissipated per unit volume. Z: touching grain-grain contacts per grain.\n"
-         "Porosity: vessel = 1 − V_grains/(π R² H); interior = in the coaxial cylinder one D_max in from every wall.\n"
-         "Time: finalization, wetting and test of the case (wall clock); packing is done once per grading.\n";
+         "loop: hysteresis, loop area ∮ q d(eps_a) = energy dissipated per unit volume. Z: touching grain-grain contacts per grain\n"
+         "(Z packed: after packing; Z: at the test start).\n"
+         "Packed with: the grain-grain contact model of the frictionless packing (mu = 0); finalization installs the material\n"
+         "and restores its friction (mu = 0.4). Each material is packed with its own model unless --pack-linear.\n"
+         "Porosity: vessel = 1 − V_grains/(π R² H); interior = in the coaxial cylinder one D_max in from every wall (D50 where\n"
+         "the vessel is too small for that: marked; n/a where even that leaves less than D_max in radius or 2 D_max in height).\n"
+         "Time: finalization, wetting and test of the case (wall clock); packing is done once per grading and packing model.\n";
   const auto f = findings();
   if (!f.empty()) {
     out += "\nFindings of the memo, checked:\n\n";
@@ -278,27 +294,38 @@ std::vector<std::string> StudyResult::findings() const {
   return out;
 }
 
-PackedResult make_packed(const StudySettings& settings, const std::string& grading_name, bool save, std::ostream* log) {
+GrainModel packing_model(const StudySettings& settings, const CaseSpec& c) {
+  return settings.pack_linear ? GrainModel::Linear : c.model;
+}
+
+PackedResult make_packed(const StudySettings& settings, const std::string& grading_name, GrainModel model, bool save,
+                         std::ostream* log) {
   const auto t0 = std::chrono::steady_clock::now();
   const Grading grading = resolve_grading(grading_name);
   const fs::path dir = fs::path(settings.output_dir) / "specimens";
+  const std::string stem = grading.name + "_" + to_string(model);
   PackedResult p;
   PackingSettings ps = settings.genesis.packing;
+  ps.contact.model = model;
   if (!settings.specimen_file.empty()) {
     p.specimen = load_packed_specimen(settings.specimen_file, &ps);
     p.file = settings.specimen_file;
     if (log)
       *log << fmt::format("specimen {}: {} grains of {} packed at {:g} kPa (seed {})\n", settings.specimen_file,
                           p.specimen.sim.balls.size(), p.specimen.grading, p.specimen.pressure / 1e3, p.specimen.seed);
+    if (log)
+      *log << fmt::format("specimen {}: packed with {} contacts\n", settings.specimen_file, to_string(p.specimen.packed_with));
     if (p.specimen.grading != grading.name && log)
       *log << fmt::format("note: the specimen was packed from grading '{}'; its distribution is compared with '{}'\n",
                           p.specimen.grading, grading.name);
   } else {
     GenesisSpec g = settings.genesis;
     g.grading = grading;
+    g.grain = settings.material;
+    g.packing = ps;
     p.specimen = pack_specimen(g, log);
     if (save) {
-      p.file = (dir / (grading.name + "_packed.csv")).string();
+      p.file = (dir / (stem + "_packed.csv")).string();
       save_packed_specimen(p.specimen, g.packing, p.file);
       if (log) *log << "packed specimen saved: " << p.file << "\n";
     }
@@ -308,25 +335,28 @@ PackedResult make_packed(const StudySettings& settings, const std::string& gradi
   p.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (log) *log << p.report.text() << state_text("packed", p.state);
   if (save && settings.specimen_file.empty()) {
-    write_file(dir / (grading.name + "_gsd.csv"), p.report.csv());
-    std::string gen = fmt::format("grading {}, seed {}, vessel {:g} mm x {:g} mm, P_m {:g} kPa\n", grading.name, p.specimen.seed,
-                                  2e3 * settings.genesis.vessel_radius, 1e3 * settings.genesis.vessel_height,
-                                  settings.genesis.packing.equilibrium.pressure / 1e3);
+    write_file(dir / (stem + "_gsd.csv"), p.report.csv());
+    std::string gen = fmt::format("grading {}, seed {}, vessel {:g} mm x {:g} mm, P_m {:g} kPa, packed with {} contacts, friction {:g}\n",
+                                  grading.name, p.specimen.seed, 2e3 * settings.genesis.vessel_radius,
+                                  1e3 * settings.genesis.vessel_height, settings.genesis.packing.equilibrium.pressure / 1e3,
+                                  to_string(model), ps.contact.fric);
     for (const PhaseReport& ph : p.specimen.phases) gen += ph.line() + "\n";
     gen += state_text("packed", p.state) + p.report.text();
-    write_file(dir / (grading.name + "_genesis.txt"), gen);
+    write_file(dir / (stem + "_genesis.txt"), gen);
   }
   return p;
 }
 
 std::string packing_table(const std::vector<PackedResult>& packed) {
-  std::string out = "| grading | seed | grains | porosity (vessel) | porosity (interior) | Z | sigma_r [kPa] | sigma_bottom [kPa] | "
-                    "sigma_top [kPa] | packing steps | time [s] |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  std::string out = "| grading | packed with | seed | grains | porosity (vessel) | porosity (interior) | Z | sigma_r [kPa] | "
+                    "sigma_bottom [kPa] | sigma_top [kPa] | packing steps | time [s] |\n"
+                    "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const PackedResult& p : packed) {
     std::int64_t steps = 0;
     for (const PhaseReport& ph : p.specimen.phases) steps += ph.steps;
-    out += fmt::format("| {} | {} | {} | {:.4f} | {:.4f} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {} | {:.0f} |\n", p.report.name,
-                       p.specimen.seed, p.state.grains, p.state.porosity, p.state.interior_porosity, p.state.coordination,
+    out += fmt::format("| {} | {} | {} | {} | {:.4f} | {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {} | {:.0f} |\n", p.report.name,
+                       to_string(p.specimen.packed_with), p.specimen.seed, p.state.grains, p.state.porosity, interior_text(p.state),
+                       p.state.coordination,
                        p.state.radial_stress / 1e3, p.state.bottom_stress / 1e3, p.state.top_stress / 1e3, steps, p.seconds);
   }
   return out;
@@ -459,12 +489,19 @@ void for_each_job(std::size_t count, int jobs, bool share_cores, bool prefix, co
     if (e) std::rethrow_exception(e);
 }
 
-// The distinct gradings of the cases, by resolved name, in case order: {grading as given, name}.
-std::vector<std::pair<std::string, std::string>> distinct_gradings(const std::vector<CaseSpec>& cases) {
-  std::vector<std::pair<std::string, std::string>> out;
+// The distinct packings of the cases, in case order: the grading as given, its resolved name and the
+// packing model. One per grading when the specimen is loaded from a file (its own model).
+struct PackingKey {
+  std::string grading, name;
+  GrainModel model;
+  bool operator==(const PackingKey& o) const { return name == o.name && model == o.model; }
+};
+std::vector<PackingKey> distinct_packings(const StudySettings& settings, const std::vector<CaseSpec>& cases) {
+  std::vector<PackingKey> out;
+  const bool loaded = !settings.specimen_file.empty();
   for (const CaseSpec& c : cases) {
-    const std::string name = resolve_grading(c.grading).name;
-    if (std::none_of(out.begin(), out.end(), [&](const auto& g) { return g.second == name; })) out.push_back({c.grading, name});
+    const PackingKey k{c.grading, resolve_grading(c.grading).name, loaded ? GrainModel::Linear : packing_model(settings, c)};
+    if (std::find(out.begin(), out.end(), k) == out.end()) out.push_back(k);
   }
   return out;
 }
@@ -473,17 +510,28 @@ std::vector<std::pair<std::string, std::string>> distinct_gradings(const std::ve
 
 std::vector<PackedResult> make_all_packed(const StudySettings& settings, const std::vector<CaseSpec>& cases, bool save,
                                           std::ostream* log) {
-  const auto gradings = distinct_gradings(cases);
-  std::vector<PackedResult> packed(gradings.size());
+  const auto packings = distinct_packings(settings, cases);
+  std::vector<PackedResult> packed(packings.size());
   const bool loaded = !settings.specimen_file.empty();
   std::vector<std::string> labels;
-  for (const auto& g : gradings) labels.push_back((loaded ? "specimen " : "packing ") + g.second);
+  for (const PackingKey& k : packings)
+    labels.push_back(loaded ? "specimen " + k.name : "packing " + k.name + " " + to_string(k.model));
   // Prefixed log lines whenever the study runs more than one job, so that its whole log reads alike.
   const bool prefix = resolved_jobs(settings.jobs, cases.size()) > 1;
-  for_each_job(gradings.size(), resolved_jobs(settings.jobs, gradings.size()), settings.jobs != 1, prefix, labels, log, {},
+  // The longest expected first (the packing time grows with the grains; hill packing is the slower).
+  std::vector<std::size_t> order(packings.size());
+  std::vector<double> cost(packings.size());
+  for (std::size_t i = 0; i < packings.size(); ++i) {
+    order[i] = i;
+    double grains = 0.0;  // grains per unit solid volume, ∝ Σ φ_j / d_j³
+    for (const GradingBin& b : resolve_grading(packings[i].grading).bins) grains += b.fraction / std::pow(0.5 * (b.d_lower + b.d_upper), 3);
+    cost[i] = grains * (packings[i].model == GrainModel::Hill ? 1.5 : 1.0);
+  }
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return cost[x] > cost[y]; });
+  for_each_job(packings.size(), resolved_jobs(settings.jobs, packings.size()), settings.jobs != 1, prefix, labels, log, order,
                [&](std::size_t i, std::ostream* out) {
                  if (out) *out << fmt::format("\n=== {} ===\n", labels[i]) << std::flush;
-                 packed[i] = make_packed(settings, gradings[i].first, save, out);
+                 packed[i] = make_packed(settings, packings[i].grading, packings[i].model, save, out);
                });
   return packed;
 }
@@ -497,12 +545,14 @@ StudyResult run_study(const StudySettings& settings, const std::vector<CaseSpec>
   // One packing per grading, all before the first case (at once when jobs allow).
   const std::vector<PackedResult> all_packed = make_all_packed(settings, cases, settings.save_specimens, log);
   // Each case's packing, looked up once (resolving a grading may read its file), before any job starts.
-  const auto gradings = distinct_gradings(cases);
+  const auto packings = distinct_packings(settings, cases);
+  const bool loaded = !settings.specimen_file.empty();
   std::vector<const PackedResult*> packed_of(cases.size());
   for (std::size_t i = 0; i < cases.size(); ++i) {
-    const std::string name = resolve_grading(cases[i].grading).name;
+    const PackingKey key{cases[i].grading, resolve_grading(cases[i].grading).name,
+                         loaded ? GrainModel::Linear : packing_model(settings, cases[i])};
     std::size_t k = 0;
-    while (gradings[k].second != name) ++k;
+    while (!(packings[k] == key)) ++k;
     packed_of[i] = &all_packed[k];
   }
   std::vector<std::optional<CaseResult>> done(cases.size());
@@ -532,6 +582,7 @@ StudyResult run_study(const StudySettings& settings, const std::vector<CaseSpec>
     r.spec = c;
     r.grading = p.report;
     r.packed = p.state;
+    r.packed_with = p.specimen.packed_with;
     r.packing_file = p.file;
     Specimen s = p.specimen;  // a copy: every case starts from the same packed state
     Class5Material m = settings.material;
@@ -539,6 +590,11 @@ StudyResult run_study(const StudySettings& settings, const std::vector<CaseSpec>
     EquilibriumSettings e = settings.finalize;
     finalize(s, m, settings.test_walls, e, clog);
     if (c.wet) make_specimen_wet(s, settings.suction, settings.moisture_gap, e, clog);
+    if (settings.triaxial.confinement != e.pressure) {  // isotropic at σ_c before the test
+      EquilibriumSettings ce = e;
+      ce.pressure = settings.triaxial.confinement;
+      servo_equilibrium(s, ce, "confine " + s.material, clog);
+    }
     r.initial = measure(s);
     r.phases = s.phases;
     r.test = run_triaxial(s, settings.triaxial, clog);

@@ -1,6 +1,6 @@
 // The memo's Class 5 study (docs/spec/hill-model.md §5.3) as one driver: for each case (grading ×
-// material, dry or wet) a packed specimen (made once per grading, or loaded), finalization, optional
-// wetting and a triaxial test; per case a CSV history, the realised grading and the genesis log; for
+// material, dry or wet) a packed specimen (made once per grading and material, each material packed
+// with its own contact model; or loaded), finalization, optional wetting and a triaxial test; per case a CSV history, the realised grading and the genesis log; for
 // the study a summary table and the memo's qualitative findings checked with numbers.
 #pragma once
 
@@ -28,10 +28,18 @@ struct StudySettings {
   GenesisSpec genesis;                  // vessel, packing; its grading is replaced by each case's
   Class5Material material;              // Table 7; `model` is replaced by each case's
   WallContact test_walls;               // grain-wall contacts after finalization
-  EquilibriumSettings finalize;         // servo equilibrium after finalization and wetting
+  EquilibriumSettings finalize;         // servo equilibrium after finalization and wetting (at P_m)
   double suction = 20e3;                // ψ of make_wet [Pa]
   double moisture_gap = 3e-3;           // g_m of make_wet [m]
+  // Confinement σ_c: triaxial.confinement. When it differs from the packing pressure P_m, the
+  // finalized (and wetted) specimen is first brought to σ_c on every wall by the same servo
+  // equilibrium ("confine" phase), so that each test starts isotropic at σ_c.
   TriaxialSettings triaxial;
+  // The shared linear packing of earlier versions: every material packed with the frictionless linear
+  // packing contacts (genesis.packing.contact's E*, κ*), one packed specimen per grading, the hill
+  // model installed only at finalization. A deviation from the memo (lab-tests.md §3.2), kept as an
+  // option (`--pack-linear`). Default: each material packed with its own model.
+  bool pack_linear = false;
   std::string output_dir = "out/triaxial";
   std::string specimen_file;            // start from this packed specimen instead of packing
   bool save_specimens = true;           // write <output>/specimens/<grading>_packed.csv
@@ -49,9 +57,10 @@ void validate(const StudySettings& s, const std::vector<CaseSpec>& cases);
 struct CaseResult {
   CaseSpec spec;
   GradingReport grading;
+  GrainModel packed_with = GrainModel::Linear;  // grain-grain model of the packing it started from
   SpecimenState packed;                 // after packing (frictionless)
   SpecimenState initial;                // after finalization (and wetting): the test's start
-  std::vector<PhaseReport> phases;      // genesis phases of this case (packing shared by a grading)
+  std::vector<PhaseReport> phases;      // genesis phases of this case (packing shared by the cases of a grading and packing model)
   TriaxialResult test;
   double seconds = 0.0;                 // finalization + wetting + test, wall clock [s]
   double packing_seconds = 0.0;         // the packing it started from (shared by the cases of a grading) [s]
@@ -73,9 +82,10 @@ struct StudyResult {
 // (in case order) is thrown once the running ones end.
 StudyResult run_study(const StudySettings& settings, const std::vector<CaseSpec>& cases, std::ostream* log);
 
-// Genesis up to the packed specimen (cloud, frictionless packing) for one grading, or the specimen
-// loaded from settings.specimen_file; with save, written to <output>/specimens/<grading>_packed.csv
-// with its realised grading (<grading>_gsd.csv) and genesis report (<grading>_genesis.txt).
+// Genesis up to the packed specimen (cloud, frictionless packing with `model` contacts) for one
+// grading, or the specimen loaded from settings.specimen_file; with save, written to
+// <output>/specimens/<grading>_<model>_packed.csv (model: hill or linear) with its realised grading
+// (<grading>_<model>_gsd.csv) and genesis report (<grading>_<model>_genesis.txt).
 struct PackedResult {
   Specimen specimen;
   GradingReport report;
@@ -83,12 +93,15 @@ struct PackedResult {
   std::string file;     // where it was saved or loaded from
   double seconds = 0.0;
 };
-PackedResult make_packed(const StudySettings& settings, const std::string& grading, bool save, std::ostream* log);
-// make_packed for each distinct grading of the cases (by resolved name, in case order), settings.jobs
-// at once.
+PackedResult make_packed(const StudySettings& settings, const std::string& grading, GrainModel model, bool save,
+                         std::ostream* log);
+// The packing model of a case: its material's, or linear with settings.pack_linear.
+GrainModel packing_model(const StudySettings& settings, const CaseSpec& c);
+// make_packed for each distinct (grading, packing model) of the cases (by resolved name, in case
+// order; one per grading when loading settings.specimen_file), settings.jobs at once.
 std::vector<PackedResult> make_all_packed(const StudySettings& settings, const std::vector<CaseSpec>& cases, bool save,
                                           std::ostream* log);
-// One line per packed specimen: grading, seed, grains, porosities, coordination, pressures, steps, time.
+// One line per packed specimen: grading, packing model, seed, grains, porosities, coordination, pressures, steps, time.
 std::string packing_table(const std::vector<PackedResult>& packed);
 
 }  // namespace hilldem
