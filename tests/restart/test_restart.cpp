@@ -250,6 +250,27 @@ TEST(Restart, PeriodicBoxResumesBitwise) {
   }
 }
 
+TEST(Restart, RollingResistanceMomentsResumeBitwise) {
+  // examples/rolling_resistance.toml (rrlinear: a stored rolling moment per contact) halted while the
+  // ball still rolls, resumed from a checkpoint taken with a non-zero moment.
+  const std::string file = std::string(HILLDEM_SOURCE_DIR) + "/examples/rolling_resistance.toml";
+  const fs::path ref_dir = scratch("rolling_ref"), dir = scratch("rolling");
+  Scenario ref = load_scenario_file(file);
+  ref.checkpoints.every = 30000;
+  std::ostringstream log;
+  run_scenario(ref, quiet_options(ref_dir), log);
+  {
+    Scenario sc = load_scenario_file(file);
+    sc.checkpoints.every = 30000;
+    ASSERT_TRUE(run_scenario(sc, quiet_options(dir, 100000), log).halted);
+    ASSERT_GT(norm(sc.sim.contacts.moment_state.at(0)), 0.0);  // the moment the checkpoint at 90,000 holds
+  }
+  Scenario sc;
+  resume_scenario(dir.string(), sc, quiet_options(""), log);
+  EXPECT_EQ(state_difference(ref.sim, sc.sim), "");
+  EXPECT_EQ(state_digest(ref.sim), state_digest(sc.sim));
+}
+
 // Remove this process's scratch folders at exit.
 struct Cleanup : ::testing::Environment {
   void TearDown() override {

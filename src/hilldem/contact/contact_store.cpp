@@ -19,6 +19,7 @@ void ContactStore::append_new(const ContactKey& k, ImageCode img, int rule_index
   shear_disp.emplace_back();
   normal.push_back(n);
   moisture.push_back(Moisture::Dry);  // new contacts start dry (spec §2.5)
+  moment_state.emplace_back();
   gap.push_back(0.0);
   force.emplace_back();
   normal_force.push_back(0.0);

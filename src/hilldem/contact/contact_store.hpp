@@ -50,6 +50,7 @@ class ContactStore {
                                     // only while SimulationSettings::track_shear_displacement is on
   std::vector<Vec3> normal;         // n̂_c of the last step
   std::vector<Moisture> moisture;   // hill M
+  std::vector<Vec3> moment_state;   // rrlinear: M_r [N m] on piece 2, in the plane of `normal`
 
   // Results of the last force-displacement pass
   // Only what the cycle needs is stored (each column costs memory traffic on every step): the shear
@@ -75,7 +76,7 @@ class ContactStore {
     f(self.linear_params, other.linear_params); f(self.hill_params, other.hill_params);
     f(self.linear_map, other.linear_map); f(self.hill_map, other.hill_map);
     f(self.shear_state, other.shear_state); f(self.shear_disp, other.shear_disp);
-    f(self.normal, other.normal); f(self.moisture, other.moisture);
+    f(self.normal, other.normal); f(self.moisture, other.moisture); f(self.moment_state, other.moment_state);
     f(self.gap, other.gap); f(self.force, other.force);
     f(self.normal_force, other.normal_force); f(self.moisture_force, other.moisture_force);
     f(self.trial_shear, other.trial_shear);
@@ -92,7 +93,7 @@ class ContactStore {
   // Make row i a fresh contact: dry, no shear force or displacement, normal n.
   void create(std::size_t i, const Vec3& n) {
     exists[i] = 1;
-    shear_state[i] = shear_disp[i] = Vec3{};
+    shear_state[i] = shear_disp[i] = moment_state[i] = Vec3{};
     moisture[i] = Moisture::Dry;  // new contacts start dry (spec §2.5)
     normal[i] = n;
   }
@@ -100,7 +101,7 @@ class ContactStore {
   void remove(std::size_t i) {
     exists[i] = 0;
     active[i] = 0;
-    shear_state[i] = shear_disp[i] = force[i] = Vec3{};
+    shear_state[i] = shear_disp[i] = moment_state[i] = force[i] = Vec3{};
     normal_force[i] = moisture_force[i] = trial_shear[i] = k_tran[i] = k_shear[i] = 0.0;
     moisture[i] = Moisture::Dry;
   }

@@ -21,6 +21,7 @@
 #include "hilldem/engine/contact_batch.hpp"
 #include "hilldem/engine/thread_budget.hpp"
 #include "hilldem/models/lanes.hpp"
+#include "hilldem/models/rrlinear.hpp"
 #include "hilldem/motion/ball_step.hpp"
 
 namespace hilldem {
@@ -186,15 +187,21 @@ std::uint64_t Simulation::piece2_groups(const ContactKey& k) const {
 
 void Simulation::compute_mapping(ContactStore& store, std::size_t c) const {
   const ContactKey& k = store.key[c];
-  if (store.model[c] == ModelKind::Linear) {
-    const double r2 = k.kind == ContactKind::BallBall ? balls.radius[k.b] : 0.0;
-    store.linear_map[c] = linear_mapping(store.linear_params[c], balls.radius[k.a], r2);
-  } else {
-    const std::size_t a = k.a, b = k.b;  // hill contacts are ball-ball only (checked by the table)
-    store.hill_map[c] = hill_mapping(store.hill_params[c],
-                                     HillBodies{balls.radius[a], balls.radius[b], balls.young_mod[a],
-                                                balls.young_mod[b], balls.pois_ratio[a], balls.pois_ratio[b],
-                                                balls.mass[a], balls.mass[b]});
+  switch (store.model[c]) {
+    case ModelKind::Linear:
+    case ModelKind::RrLinear: {  // (the linear springs; R̄ of rrlinear is taken in force_row)
+      const double r2 = k.kind == ContactKind::BallBall ? balls.radius[k.b] : 0.0;
+      store.linear_map[c] = linear_mapping(store.linear_params[c], balls.radius[k.a], r2);
+      break;
+    }
+    case ModelKind::Hill: {
+      const std::size_t a = k.a, b = k.b;  // hill contacts are ball-ball only (checked by the table)
+      store.hill_map[c] = hill_mapping(store.hill_params[c],
+                                       HillBodies{balls.radius[a], balls.radius[b], balls.young_mod[a],
+                                                  balls.young_mod[b], balls.pois_ratio[a], balls.pois_ratio[b],
+                                                  balls.mass[a], balls.mass[b]});
+      break;
+    }
   }
 }
 
@@ -645,6 +652,19 @@ Simulation::RowShare Simulation::force_row(std::size_t c, double dt) {
       if (out.active) stiff = {contacts.linear_map[c].kn, contacts.linear_map[c].ks};
       break;
     }
+    case ModelKind::RrLinear: {
+      const Vec3 moment = carry_into_plane(contacts.moment_state[c], contacts.normal[c], normal, mean_spin, dt);
+      const RrLinearResult r =
+          rrlinear_force(contacts.linear_params[c], contacts.linear_map[c], kin, RrLinearState{carried, moment},
+                         spin2 - rec[a].spin, rrlinear_radius(r1, ball2 ? rad[key.b] : 0.0));
+      out.shear = r.linear.state.shear_force;
+      out.force = r.linear.force, out.normal_force = r.linear.normal_force, out.trial_shear = r.linear.trial_shear;
+      out.active = r.linear.active;
+      out.moment = r.moment;
+      out.wall_row = !ball2;
+      if (out.active) stiff = {contacts.linear_map[c].kn, contacts.linear_map[c].ks};
+      break;
+    }
   }
   out.k_tran = stiff.kn + stiff.ks;
   out.k_shear = stiff.ks;
@@ -703,8 +723,10 @@ HILLDEM_INLINE void Simulation::store_row(std::size_t c, const RowOutcome& out, 
   const ContactMoments<double> m =
       contact_moments(lanes::v3(out.normal), out.gap, out.r1, out.r2, lanes::v3(out.force));
   share.force = -out.force;
-  share.moment = lanes::vec3(m.on1);
-  share.moment2 = lanes::vec3(m.on2);
+  // The contact moment M_c (rrlinear) on piece 2, −M_c on piece 1; a wall row's second share is its
+  // ball's (piece 1).
+  share.moment = lanes::vec3(m.on1) - out.moment;
+  share.moment2 = out.wall_row ? lanes::vec3(m.on2) - out.moment : lanes::vec3(m.on2) + out.moment;
   share.ok = std::isfinite(out.force.x + out.force.y + out.force.z);
   if (want_stiffness) {  // what add_row_stiffness reads (zero when inactive)
     share.k_tran = out.k_tran;
@@ -717,6 +739,7 @@ HILLDEM_INLINE void Simulation::store_row(std::size_t c, const RowOutcome& out, 
   // sums read them (and the gap when the force is not finite: the run's error message names it).
   contacts.shear_state[c] = out.shear;
   contacts.normal[c] = out.normal;
+  contacts.moment_state[c] = out.moment;
   if (reported) contacts.force[c] = out.force;
   if (reported || want_stiffness || !share.ok) contacts.gap[c] = out.gap;
   if (reported) {
@@ -1166,6 +1189,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
         switch (contacts.model[c]) {
           case ModelKind::Hill: batch = &hill; break;
           case ModelKind::Linear: batch = &linear; break;
+          case ModelKind::RrLinear: break;  // (row by row: no batch)
         }
         if (!exists || batch == nullptr) {  // a new contact, or a model without a batch: row by row
           if (hill.size() > 0) flush(hill);
@@ -1680,9 +1704,9 @@ void Simulation::collect_forces() {
     Wall& w = walls.walls[k.b];
     const Vec3 point = ball_kin_[k.a].position + contacts.normal[c] * (balls.radius[k.a] + 0.5 * contacts.gap[c]);
     w.force += contacts.force[c];
-    w.moment += cross(point - w.rotation_center, contacts.force[c]);
+    w.moment += cross(point - w.rotation_center, contacts.force[c]) + contacts.moment_state[c];  // (+ M_c: rrlinear)
     w.normal_force += dot(contacts.force[c], contacts.normal[c]);
-    w.normal_stiffness += contacts.model[c] == ModelKind::Linear ? contacts.linear_map[c].kn : contacts.k_tran[c];
+    w.normal_stiffness += contacts.model[c] == ModelKind::Hill ? contacts.k_tran[c] : contacts.linear_map[c].kn;
     ++w.active_contacts;
   }
   stiffness_ready_ = want_stiffness;

@@ -232,6 +232,8 @@ class Simulation {
     Vec3 shear;                   // shear force carried to the next step [N]
     double normal_force = 0.0, moisture_force = 0.0, trial_shear = 0.0;  // [N]
     double k_tran = 0.0, k_shear = 0.0;  // [N/m], written only when the time step needs them
+    Vec3 moment;                  // contact moment M_c on piece 2 [N m] (rrlinear; zero for other models)
+    bool wall_row = false;        // (for M_c's share: a wall row's second share is its ball's)
     Moisture moisture = Moisture::Dry;
     bool active = false;
   };

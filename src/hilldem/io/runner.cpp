@@ -31,7 +31,7 @@ const ProbeValue* RunResult::find(const std::string& label) const {
 namespace {
 
 const char* moisture_text(const ContactStore& c, std::size_t k) {
-  return c.model[k] == ModelKind::Linear ? "-"
+  return c.model[k] != ModelKind::Hill ? "-"
          : c.moisture[k] == Moisture::Wet ? "wet"
          : c.moisture[k] == Moisture::Ruptured ? "rupt"
                                                : "dry";
@@ -187,6 +187,7 @@ void apply_set_contacts(Simulation& sim, const Stage& s) {
       if (s.fric) p.fric = *s.fric;
       if (s.emod) p.emod = *s.emod;
       if (s.kratio) p.kratio = *s.kratio;
+      if (s.rolling_fric) p.rolling_fric = *s.rolling_fric;
     }
   }
   sim.refresh_mappings();  // β_n, β_s depend on γ_h; k_n on E* (spec §2.4)

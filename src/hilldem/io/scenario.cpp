@@ -528,7 +528,7 @@ class Reader {
       r.groups2_text = groups[1];
       r.groups2 = group_filter(t, groups[1], sim, "groups");
     }
-    const std::string model = t.choice("model", std::nullopt, {"linear", "hill"});
+    const std::string model = t.choice("model", std::nullopt, {"linear", "hill", "rrlinear"});
     if (model == "hill") {
       if (r.kind != ContactKind::BallBall)
         t.fail("model", "the hill model exists only between grains (ball-ball); use \"linear\" for ball-wall (spec §2.1)");
@@ -537,10 +537,12 @@ class Reader {
       r.hill.damp_con = t.real("damp_con", 0.0, kDampCon, "[-]");
       r.hill.suction = t.real("suction", 0.0, Range::closed(0.0, kInf), "[Pa]");
     } else {
-      r.model = ModelKind::Linear;
+      r.model = model == "rrlinear" ? ModelKind::RrLinear : ModelKind::Linear;
       r.linear.emod = t.real("emod", std::nullopt, Range::positive(), "[Pa]");
       r.linear.kratio = t.real("kratio", 1.0, Range::positive(), "[-]");
       r.linear.fric = t.real("fric", 0.0, Range::closed(0.0, kInf), "[-]");
+      if (r.model == ModelKind::RrLinear)  // μ_r (docs/spec/rrlinear.md)
+        r.linear.rolling_fric = t.real("rr_fric", 0.0, Range::closed(0.0, kInf), "[-]");
     }
     t.finish();
     if (sim.rules.size() >= 30000) t.fail("name", "at most 30000 assignment rules");
@@ -628,8 +630,8 @@ class Reader {
       }
     } else if (type == "set_contacts") {
       s.type = StageType::SetContacts;
-      const std::string m = t.choice("model", std::nullopt, {"linear", "hill"});
-      s.model_filter = m == "hill" ? ModelKind::Hill : ModelKind::Linear;
+      const std::string m = t.choice("model", std::nullopt, {"linear", "hill", "rrlinear"});
+      s.model_filter = m == "hill" ? ModelKind::Hill : m == "rrlinear" ? ModelKind::RrLinear : ModelKind::Linear;
       if (m == "hill") {
         if (t.has("fric_coef")) s.fric = t.real("fric_coef", std::nullopt, Range::closed(0.0, kInf), "[-]");
         if (t.has("damp_con")) s.damp_con = t.real("damp_con", std::nullopt, kDampCon, "[-]");
@@ -638,6 +640,8 @@ class Reader {
         if (t.has("fric")) s.fric = t.real("fric", std::nullopt, Range::closed(0.0, kInf), "[-]");
         if (t.has("emod")) s.emod = t.real("emod", std::nullopt, Range::positive(), "[Pa]");
         if (t.has("kratio")) s.kratio = t.real("kratio", std::nullopt, Range::positive(), "[-]");
+        if (m == "rrlinear" && t.has("rr_fric"))
+          s.rolling_fric = t.real("rr_fric", std::nullopt, Range::closed(0.0, kInf), "[-]");
       }
     } else if (type == "set_simulation") {
       s.type = StageType::SetSimulation;

@@ -38,7 +38,7 @@ struct Stage {
   FixityMask fix = 0, free = 0;                                 // set
   // set_contacts: filter and new values
   std::optional<ModelKind> model_filter;
-  std::optional<double> fric, damp_con, suction, emod, kratio;
+  std::optional<double> fric, damp_con, suction, emod, kratio, rolling_fric;
   // set_simulation
   std::optional<Vec3> gravity;
   std::optional<double> local_damping, timestep;  // timestep 0 = auto

@@ -36,12 +36,12 @@ static_assert(tripwire::initialisers<ModelRule>() == 9, "ModelRule changed: upda
 static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 changed: update io/state_io.cpp");
 static_assert(sizeof(HillParams) == 3 * sizeof(double), "HillParams changed: update io/state_io.cpp");
 static_assert(sizeof(HillMapping) == 9 * sizeof(double), "HillMapping changed: update io/state_io.cpp");
-static_assert(sizeof(LinearParams) == 3 * sizeof(double), "LinearParams changed: update io/state_io.cpp");
+static_assert(sizeof(LinearParams) == 4 * sizeof(double), "LinearParams changed: update io/state_io.cpp");
 static_assert(sizeof(LinearMapping) == 2 * sizeof(double), "LinearMapping changed: update io/state_io.cpp");
 static_assert(sizeof(ContactKey) == 12, "ContactKey changed: update io/state_io.cpp");
 static_assert(sizeof(Wall) == 352, "Wall changed: update write_wall/read_wall in io/state_io.cpp");
 static_assert(sizeof(SimulationSettings) == 144, "SimulationSettings changed: update io/state_io.cpp");
-static_assert(sizeof(ModelRule) == 176, "ModelRule changed: update io/state_io.cpp");
+static_assert(sizeof(ModelRule) == 184, "ModelRule changed: update io/state_io.cpp");
 
 namespace {
 
@@ -184,6 +184,12 @@ SimulationSettings read_settings(SectionReader& r) {
   return s;
 }
 
+// Section versions: 2 added rrlinear (the rules' μ_r, the contacts' moment_state column). A table of
+// version 1 reads with μ_r = 0; contacts of version 1 are refused (their state digest covers another
+// layout).
+constexpr std::uint32_t kTableVersion = 2;
+constexpr std::uint32_t kContactsVersion = 2;
+
 // ---- groups and table ----
 
 void write_rule(SectionWriter& w, const ModelRule& r) {
@@ -197,6 +203,7 @@ void write_rule(SectionWriter& w, const ModelRule& r) {
   w.f64(r.linear.emod);
   w.f64(r.linear.kratio);
   w.f64(r.linear.fric);
+  w.f64(r.linear.rolling_fric);
   w.f64(r.hill.fric_coef);
   w.f64(r.hill.damp_con);
   w.f64(r.hill.suction);
@@ -211,13 +218,14 @@ ModelRule read_rule(SectionReader& r) {
   x.groups1_text = r.str(4096);
   x.groups2_text = r.str(4096);
   const std::uint8_t model = r.u8();
-  if (kind > 1 || model > 1) r.fail("rule '" + x.name + "' has an unknown contact kind or model");
+  if (kind > 1 || model >= kModelCount) r.fail("rule '" + x.name + "' has an unknown contact kind or model");
   x.kind = static_cast<ContactKind>(kind);
   x.model = static_cast<ModelKind>(model);
   if (x.model == ModelKind::Hill && x.kind != ContactKind::BallBall) r.fail("rule '" + x.name + "': hill between a ball and a wall");
   x.linear.emod = r.f64();
   x.linear.kratio = r.f64();
   x.linear.fric = r.f64();
+  if (r.version() >= 2) x.linear.rolling_fric = r.f64();  // (version 1: no rrlinear, μ_r = 0)
   x.hill.fric_coef = r.f64();
   x.hill.damp_con = r.f64();
   x.hill.suction = r.f64();
@@ -255,7 +263,7 @@ constexpr const char* kBallColumns[] = {"id", "radius", "density", "mass", "iner
                                         "applied_force", "applied_moment"};
 constexpr const char* kContactColumns[] = {
     "key", "image", "exists", "rule", "model", "linear_params", "hill_params", "linear_map", "hill_map", "shear_state",
-    "shear_disp", "normal", "moisture", "gap", "force", "normal_force", "moisture_force",
+    "shear_disp", "normal", "moisture", "moment_state", "gap", "force", "normal_force", "moisture_force",
     "trial_shear", "active", "k_tran", "k_shear"};
 
 template <std::size_t N>
@@ -285,7 +293,7 @@ void check_contacts(SectionReader& r, const ContactStore& c, std::size_t n_balls
     if (c.exists[i] > 1 || c.active[i] > 1) r.fail(row + " has a flag that is neither 0 nor 1");
     if (c.rule[i] < 0 || static_cast<std::size_t>(c.rule[i]) >= n_rules)
       r.fail(row + " refers to assignment rule " + std::to_string(c.rule[i]) + " of " + std::to_string(n_rules));
-    if (static_cast<std::uint8_t>(c.model[i]) > 1) r.fail(row + " has an unknown model code");
+    if (static_cast<std::uint8_t>(c.model[i]) >= kModelCount) r.fail(row + " has an unknown model code");
     if (c.model[i] == ModelKind::Hill && key.kind != ContactKind::BallBall) r.fail(row + ": a hill contact with a wall");
     if (static_cast<std::uint8_t>(c.moisture[i]) > 2) r.fail(row + " has an unknown moisture state");
   }
@@ -316,7 +324,7 @@ void write_simulation(CheckpointWriter& w, const Simulation& sim) {
     for (const std::string& n : names) s.str(n);
   }
   {
-    SectionWriter& s = w.section("sim.table");
+    SectionWriter& s = w.section("sim.table", kTableVersion);
     s.u64(sim.table.rules.size());
     for (const ModelRule& r : sim.table.rules) write_rule(s, r);
   }
@@ -335,7 +343,7 @@ void write_simulation(CheckpointWriter& w, const Simulation& sim) {
     for (const Wall& x : sim.walls.walls) write_wall(s, x);
   }
   {
-    SectionWriter& s = w.section("sim.contacts");
+    SectionWriter& s = w.section("sim.contacts", kContactsVersion);
     std::uint32_t columns = 0;
     ContactStore::zip_columns(sim.contacts, sim.contacts, [&](const auto&, const auto&) { ++columns; });
     s.u32(columns);
@@ -386,7 +394,7 @@ void read_simulation(const CheckpointReader& cr, Simulation& out, bool prepare_t
     r.finish();
   }
   {
-    SectionReader r = cr.section("sim.table");
+    SectionReader r = cr.section("sim.table", kTableVersion);
     const std::uint64_t n = r.count(32, 32767);
     for (std::uint64_t k = 0; k < n; ++k) sim.table.rules.push_back(read_rule(r));
     r.finish();
@@ -466,7 +474,11 @@ void read_simulation(const CheckpointReader& cr, Simulation& out, bool prepare_t
     r.finish();
   }
   {
-    SectionReader r = cr.section("sim.contacts");
+    SectionReader r = cr.section("sim.contacts", kContactsVersion);
+    // (Version 1, before rrlinear, had no moment_state column.)
+    if (r.version() < kContactsVersion)
+      r.fail("contacts of section version " + std::to_string(r.version()) +
+             ", written by an older hilldem build: resume it with that build");
     std::uint32_t expected = 0;
     ContactStore::zip_columns(sim.contacts, sim.contacts, [&](auto&, auto&) { ++expected; });
     const std::uint32_t columns = r.u32();

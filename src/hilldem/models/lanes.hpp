@@ -53,7 +53,8 @@ template <class R> HILLDEM_INLINE R min(R a, R b) { return select(b < a, b, a); 
 HILLDEM_INLINE double sqrt(double x) { return std::sqrt(x); }
 HILLDEM_INLINE Pack sqrt(Pack x) {
 #if defined(__AVX512F__)
-  return reinterpret_cast<Pack>(_mm512_sqrt_pd(reinterpret_cast<__m512d>(x)));
+  const __m512d v = reinterpret_cast<__m512d>(x);
+  return reinterpret_cast<Pack>(_mm512_mask_sqrt_pd(v, 0xFF, v));  // (the masked form: no undefined source operand)
 #else
   Pack r;
   for (std::size_t i = 0; i < kWidth; ++i) r[i] = std::sqrt(x[i]);

@@ -17,6 +17,7 @@ struct LinearParams {
   double emod = 0.0;    // E* [Pa], effective modulus of the deformability method, [0, ∞)
   double kratio = 1.0;  // κ* [-], normal-to-shear stiffness ratio, (0, ∞)
   double fric = 0.0;    // μ [-], friction coefficient, [0, ∞)
+  double rolling_fric = 0.0;  // μ_r [-], rolling-resistance coefficient, [0, ∞): rrlinear only (models/rrlinear.hpp)
 };
 
 struct LinearMapping {

@@ -3,7 +3,14 @@
 namespace hilldem {
 
 const char* to_string(ContactKind k) { return k == ContactKind::BallBall ? "ball-ball" : "ball-wall"; }
-const char* to_string(ModelKind m) { return m == ModelKind::Linear ? "linear" : "hill"; }
+const char* to_string(ModelKind m) {
+  switch (m) {
+    case ModelKind::Linear: return "linear";
+    case ModelKind::Hill: return "hill";
+    case ModelKind::RrLinear: return "rrlinear";
+  }
+  return "unknown";
+}
 
 namespace {
 bool in(std::uint64_t mask, std::uint64_t groups) { return mask == 0 || (mask & groups) != 0; }

@@ -12,7 +12,11 @@
 namespace hilldem {
 
 enum class ContactKind : std::uint8_t { BallBall = 0, BallWall = 1 };
-enum class ModelKind : std::uint8_t { Linear = 0, Hill = 1 };
+// The contact models. A switch over ModelKind names every one (no default; -Werror=switch), so that a
+// model added here without its law in the force pass, its reader and its checkpoint code does not
+// compile.
+enum class ModelKind : std::uint8_t { Linear = 0, Hill = 1, RrLinear = 2 };
+inline constexpr std::uint8_t kModelCount = 3;
 
 const char* to_string(ContactKind k);
 const char* to_string(ModelKind m);
@@ -25,7 +29,7 @@ struct ModelRule {
   std::uint64_t groups1 = 0, groups2 = 0;
   std::string groups1_text = "any", groups2_text = "any";  // for listings
   ModelKind model = ModelKind::Linear;
-  LinearParams linear;
+  LinearParams linear;  // linear and rrlinear (μ_r)
   HillParams hill;
 };
 
