@@ -26,7 +26,7 @@ struct MemoryBandwidth {
 MemoryBandwidth measure_memory_bandwidth(std::size_t array_bytes = std::size_t{256} << 20, int passes = 5);
 
 // What one core sees at one working-set size: why a bed whose step data fit in the caches runs
-// faster per particle than one whose data do not (docs/performance.md, seventeenth session). Two
+// faster per particle than one whose data do not (docs/performance.md, "What limits it"). Two
 // figures per size, one thread, best of several passes:
 // - a streaming read-modify-write (a = s a + b over two arrays of half the size each, every byte
 //   counted), the way the force pass walks its row columns;

@@ -2,10 +2,9 @@
 // the BallStore's columns, and the engine's pass over its ball records (Simulation, unwatched steps).
 // One function, so both give the same bits by construction.
 //
-// It works on the three components as one vector (a fourth lane is computed and never stored): the
-// scalar version ran three chains per vector with their damping signs and fixity selects through
-// integer registers, 185 instructions per ball (callgrind). Each lane does exactly the scalar
-// arithmetic.
+// It works on the three components as one vector (a fourth lane is computed and never stored), so
+// that the damping signs and fixity selects stay in vector registers. Each lane does exactly the
+// scalar arithmetic.
 #pragma once
 
 #include <cstdint>
