@@ -294,10 +294,10 @@ void Simulation::advance_records(double dt, const double* inertial_mass, const d
   const motion::ContactSums* sums = contact_sums();
   // [m²/s²], [m²], [m²] (a NaN wins: see rebuild_if_needed)
   double max_v2 = 0.0, max_x2 = 0.0, worst_live = 0.0;
-  // Each thread's balls: in proportion to the threads' shares of the force pass (thread_share_:
-  // equal, given or by their measured speeds), so that a thread on a slower core is not the one
-  // every other waits for. Which thread moves a ball changes no result.
-  const std::vector<double>& shares = thread_share_;  // (not changed during the pass)
+  // Each thread's balls: in proportion to the threads' shares of the force pass (WorkSplit: equal,
+  // given or by their measured speeds), so that a thread on a slower core is not the one every other
+  // waits for. Which thread moves a ball changes no result.
+  const std::vector<double>& shares = split_.shares();  // (not changed during the pass)
   auto pass = [&](auto applied) {
 #pragma omp parallel if (n > kParallelMin)
     {
@@ -1300,87 +1300,6 @@ void Simulation::wall_block(std::size_t k0, std::size_t k1, double dt, BlockScra
   if (batch.size() > 0) flush();
 }
 
-bool Simulation::balance_speeds() {
-  // Each thread's speed over the passes since the split: its work (split_work's units) over its time
-  // in the blocks [s]. The cores of a shared machine run at different speeds (here one of the two
-  // often runs 1.3 x slower than the other, which one changing from run to run), and with equal work
-  // the faster thread waits for the slower at the end of every pass. Shares of the work in
-  // proportion to the speeds, half way from the last shares (the speeds are noisy); a new split only
-  // if a share moved by more than 1 %. Which balls a thread sums changes no result (force_pass).
-  const std::size_t threads = thread_share_.size();
-  if (!thread_shares.empty() || threads < 2 || thread_busy_.size() != threads ||
-      work_start_.size() != threads + 1 || work_prefix_.size() != balls.size() + 1)
-    return false;
-  std::vector<double> speed(threads);
-  double total = 0.0;
-  for (std::size_t t = 0; t < threads; ++t) {
-    const double work = static_cast<double>(work_prefix_[work_start_[t + 1]] - work_prefix_[work_start_[t]]);
-    if (!(thread_busy_[t] > 0.0) || !(work > 0.0)) return false;
-    speed[t] = work / thread_busy_[t];
-    total += speed[t];
-  }
-  // (No share below a tenth of an equal one: a thread with no balls could not be timed again.)
-  const double least = 0.1 / static_cast<double>(threads);
-  std::vector<double> share(threads);
-  double sum = 0.0;
-  for (std::size_t t = 0; t < threads; ++t) {
-    share[t] = std::max(0.5 * thread_share_[t] + 0.5 * speed[t] / total, least);
-    sum += share[t];
-  }
-  bool moved = false;
-  for (std::size_t t = 0; t < threads; ++t) {
-    moved |= std::abs(share[t] / sum - thread_share_[t]) > 0.01;
-    thread_share_[t] = share[t] / sum;
-  }
-  return moved;
-}
-
-void Simulation::split_work(int threads) {
-  // Work of ball i in the pass, in units of a neighbour row that is not a contact, and two for the
-  // ball itself (its record, its half of the force sum). With the live rows: four for each live row
-  // (gather, law and scatter); the list holds these counts already. Without (every row through
-  // force_row): four for each of its rows. And four for each of its wall rows, which its thread runs.
-  // Threads get ranges of equal work, not of equal numbers of balls: rows and contacts per ball vary
-  // across a specimen (denser at the bottom of a bed, none above its surface), and with equal
-  // numbers of balls one thread waited at the end of the pass (a third of its time on an unsettled
-  // bed).
-  const std::size_t n = balls.size();
-  work_start_.assign(static_cast<std::size_t>(threads) + 1, n);
-  work_start_[0] = 0;
-  if (threads <= 1 || n == 0) {
-    // (Equal shares: without them force_pass took every pass for a new split, and made the crossing
-    // floor again each time.)
-    const auto count = static_cast<std::size_t>(std::max(threads, 1));
-    thread_share_.assign(count, 1.0 / static_cast<double>(count));
-    return;
-  }
-  std::vector<std::uint64_t>& prefix = work_prefix_;
-  prefix.resize(n + 1);
-  prefix[0] = 0;
-  const bool live = live_now_ && live_ready_ && live_first_.size() == n + 1;
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::uint64_t rows = live ? live_first_[i + 1] - live_first_[i] : first_rows_[i + 1] - first_rows_[i];
-    prefix[i + 1] = prefix[i] + 2 + 4 * rows + 4 * (wall_rows_start_[i + 1] - wall_rows_start_[i]);
-  }
-  // Thread t's share of the work: given (thread_shares), or in proportion to the threads' speeds
-  // (balance_speeds; equal at first).
-  const auto count = static_cast<std::size_t>(threads);
-  if (thread_shares.size() == count) {
-    const double sum = std::accumulate(thread_shares.begin(), thread_shares.end(), 0.0);
-    thread_share_.resize(count);
-    for (std::size_t t = 0; t < count; ++t)
-      thread_share_[t] = sum > 0.0 ? std::max(thread_shares[t], 0.0) / sum : 1.0 / threads;
-  } else if (thread_share_.size() != count) {
-    thread_share_.assign(count, 1.0 / threads);
-  }
-  double before = 0.0;
-  for (std::size_t t = 1; t < count; ++t) {
-    before += thread_share_[t - 1];
-    const auto target = static_cast<std::uint64_t>(static_cast<double>(prefix[n]) * std::min(before, 1.0));
-    work_start_[t] = static_cast<std::size_t>(std::lower_bound(prefix.begin(), prefix.end(), target) - prefix.begin());
-  }
-}
-
 void Simulation::refresh_live_rows() {
   // The slack s: the list is made again when any ball has moved more than s since; it holds the
   // neighbour pairs within proximity + 2 s. A list that lasted fewer than kLiveShort passes doubles
@@ -1481,7 +1400,7 @@ void Simulation::force_pass(double dt) {
   const std::size_t n = balls.size();
   // Blocks of balls, each with its own rows (ball-ball rows are sorted by their first ball); each
   // row writes only its own columns. Each thread takes a range of balls of equal work
-  // (split_work) in blocks of balls_per_block from its start, and runs the blocks from the last
+  // (WorkSplit) in blocks of balls_per_block from its start, and runs the blocks from the last
   // down. Every ball's force is summed in one order whatever the ranges: its ball-ball rows in
   // descending row order, then its wall rows (first_rows_, force_block, collect_forces). So results
   // depend neither on the blocks (ContactBatch::pad_lanes) nor on the thread count. The first
@@ -1547,31 +1466,17 @@ void Simulation::force_pass(double dt) {
     std::unique_ptr<BlockScratch> scratch(new BlockScratch);
 #pragma omp single
     {
-      // The split is a serial pass over the balls (≈ 2 % of a two-thread step at 100,800 balls) and
-      // moves slowly with the contacts; it changes no result, so it is redone only when the rows or
-      // the thread count changed, every kSplitEvery passes, or when the threads' speeds moved their
-      // shares (balance_speeds, every kSpeedEvery passes).
       const auto threads = static_cast<std::size_t>(omp_get_num_threads());
-      bool resplit = work_start_.size() != threads + 1 || work_start_.back() != n || split_rows_ != rows ||
-                     thread_share_.size() != threads ||
-                     ++split_age_ >= kSplitEvery;
-      if (!resplit && ++speed_age_ >= kSpeedEvery) resplit = balance_speeds();
-      if (resplit) {
-        split_work(omp_get_num_threads());
-        split_rows_ = rows;
-        split_age_ = 0;
-      }
-      if (resplit || speed_age_ >= kSpeedEvery) {  // the speeds measured afresh
-        thread_busy_.assign(threads, 0.0);
-        speed_age_ = 0;
-      }
+      const bool live_split = live_now_ && live_ready_ && live_first_.size() == n + 1;
+      const bool resplit = split_.prepare(threads, n, rows, thread_shares,
+                                          live_split ? live_first_.data() : first_rows_.data(), wall_rows_start_.data());
       crossing_.resize(threads);
       if (resplit || crossing_floor_.size() != threads) crossing_floor_.assign(threads, kFloorUnknown);
       crossing_done.reset(new std::atomic<bool>[threads]);
       for (std::size_t u = 0; u < threads; ++u) crossing_done[u].store(false, std::memory_order_relaxed);
     }
     const auto t = static_cast<std::size_t>(omp_get_thread_num());
-    const std::size_t first = work_start_[t], last = work_start_[t + 1];
+    const std::size_t first = split_.begin(t), last = split_.end(t);
     std::vector<CrossShare>& crossing = crossing_[t];
     crossing.clear();
     // One thread needs no timing: its share is the whole.
@@ -1622,7 +1527,7 @@ void Simulation::force_pass(double dt) {
       wall_block(k0, k1, dt, *scratch, bad_row, batched);
       add_wall_rows(k0, k1);
     }
-    if (timed) thread_busy_[t] += omp_get_wtime() - busy_from;  // [s] (balance_speeds)
+    if (timed) split_.add_busy(t, omp_get_wtime() - busy_from);  // [s]
   }
   if (late_share.load()) throw RunError("internal error: a crossing share after its list was final (force_pass)");
   batched_rows_ = batched;

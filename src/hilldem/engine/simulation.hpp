@@ -20,6 +20,7 @@
 #include "hilldem/bodies/wall_store.hpp"
 #include "hilldem/contact/contact_store.hpp"
 #include "hilldem/engine/contact_batch.hpp"
+#include "hilldem/engine/work_split.hpp"
 #include "hilldem/models/model_table.hpp"
 #include "hilldem/motion/ball_step.hpp"
 #include "hilldem/motion/law_of_motion.hpp"
@@ -186,8 +187,6 @@ class Simulation {
     applied_known_ = false;
     skin_known_ = false;
   }
-  // work_start_[t]: the first ball of thread t's range in the force pass, cut at equal work.
-  void split_work(int threads);
   // What a row gives its two bodies (zero when the row is not an active contact).
   struct RowShare {
     Vec3 force;    // on piece 1: −F_c [N] (piece 2 gets F_c = −force)
@@ -354,18 +353,7 @@ class Simulation {
   bool applied_known_ = false, applied_zero_ = false;
   bool skin_known_ = false;
   double skin_ = 0.0;  // [m] skin() while skin_known_
-  std::vector<std::size_t> work_start_;        // threads' ranges of balls in the force pass (split_work)
-  std::vector<std::uint64_t> work_prefix_;     // split_work's running sum of work per ball
-  std::size_t split_rows_ = 0;                 // rows when the split was made
-  int split_age_ = 0;                          // force passes since
-  static constexpr int kSplitEvery = 50;
-  // Threads' shares of the work (split_work), and their time in the blocks since the split [s]
-  // (balance_speeds, looked at every kSpeedEvery passes).
-  std::vector<double> thread_share_;
-  std::vector<double> thread_busy_;
-  static constexpr int kSpeedEvery = 10;
-  int speed_age_ = 0;  // force passes since the speeds were measured afresh
-  bool balance_speeds();  // true: the shares moved, split again
+  WorkSplit split_;  // the threads' ranges of balls in the force pass
   bool body_terms_ready_ = false;            // ball_kin_[i].terms are up to date (see force_pass)
   // The hill parameters the batched pass reads, by set: row c's are hill_sets_[row_hill_set_[c]], the
   // distinct parameters of the rows and the rules (a few: the rules', and what make_wet and stages
