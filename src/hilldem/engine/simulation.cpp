@@ -91,7 +91,7 @@ void Simulation::step_once(bool last) {
     step_body(last);
   } catch (...) {
     sync_ball_columns();  // the state where the run stopped, for whoever catches this
-    if (live_records_ready_) sync_live_records();
+    if (live_.records_ready()) live_.sync_records(contacts);
     throw;
   }
 }
@@ -221,7 +221,7 @@ void Simulation::create_contact(std::size_t c, const Vec3& normal) {
 }
 
 void Simulation::refresh_param_sets() {
-  if (live_records_ready_) sync_live_records();  // (the records hold the rows' sets)
+  if (live_.records_ready()) live_.sync_records(contacts);  // (the records hold the rows' sets)
   // The distinct parameters, told apart by their bits, so that each row's set holds exactly its
   // parameters. Rows mostly share their neighbour's set: one comparison, and a map lookup only when
   // the parameters change along the rows.
@@ -277,10 +277,11 @@ void Simulation::advance_records(double dt, const double* inertial_mass, const d
   const std::size_t n = balls.size();
   const double alpha = settings.local_damping;
   const V4 gravity = load(settings.gravity);
-  const bool live_list = live_ready_ && position_at_live_.size() == n;
+  const bool live_list = live_.has_positions(n);
+  const Vec3* at_live = live_.positions();
   // The travel since the live rows ball by ball (reading each ball's position then), or bounded
   // without it while the bound, grown by four steps like the last, stays within the slack.
-  const bool bounded = live_list && live_bound_valid_ && live_travel_ + 4.0 * live_growth_ <= live_slack_;
+  const bool bounded = live_list && live_.bound_holds();
   const bool live = live_list && !bounded;
   if (!applied_known_) {  // (once per cycle() call: nothing changes them until then)
     const auto zero = [](const std::vector<Vec3>& v) {
@@ -332,7 +333,7 @@ void Simulation::advance_records(double dt, const double* inertial_mass, const d
         if (!(v2 <= mine_v2)) mine_v2 = v2;
         if (!(x2 <= mine_x2)) mine_x2 = x2;
         if (live) {
-          const double l2 = norm2(k.position - position_at_live_[i]);
+          const double l2 = norm2(k.position - at_live[i]);
           if (!(l2 <= mine_live)) mine_live = l2;
         }
       }
@@ -353,11 +354,7 @@ void Simulation::advance_records(double dt, const double* inertial_mass, const d
   const double growth = std::sqrt(max_v2) * dt * (1.0 + 1e-9) + 1e-15 * std::sqrt(max_x2);
   travel_bound_ += growth;
   motion_travel_known_ = true;
-  if (live) live_travel_ = std::sqrt(worst_live);  // (exact)
-  else if (bounded) live_travel_ += growth;
-  live_growth_ = growth;
-  live_bound_valid_ = live_list;
-  live_travel_known_ = live_list;
+  live_.after_motion(live_list, live, bounded, worst_live, growth);
 }
 
 void Simulation::sync_ball_columns() {
@@ -392,7 +389,8 @@ void Simulation::rebuild_if_needed() {
     // positions from the records when the columns lag behind them.)
     const std::size_t n = balls.size();
     const bool from_records = columns_stale_;
-    const bool live = live_ready_ && position_at_live_.size() == n;
+    const bool live = live_.has_positions(n);
+    const Vec3* at_live = live_.positions();
     double worst = 0.0, worst_live = 0.0;
 #pragma omp parallel if (n > kParallelMin)
     {
@@ -403,7 +401,7 @@ void Simulation::rebuild_if_needed() {
         const double d2 = norm2(x - position_at_build_[i]);
         if (!(d2 <= mine)) mine = d2;
         if (live) {
-          const double l2 = norm2(x - position_at_live_[i]);
+          const double l2 = norm2(x - at_live[i]);
           if (!(l2 <= mine_live)) mine_live = l2;
         }
       }
@@ -413,9 +411,7 @@ void Simulation::rebuild_if_needed() {
         if (!(mine_live <= worst_live)) worst_live = mine_live;
       }
     }
-    live_travel_ = std::sqrt(worst_live);
-    live_travel_known_ = live;
-    live_bound_valid_ = live;
+    live_.measured(live, worst_live);
     const double ball_travel = std::sqrt(worst);
     travel_bound_ = ball_travel;  // (exact now: the record motion grows it from here)
     if (ball_travel <= half && ball_travel + wall_travel_ <= 2.0 * half) return;
@@ -425,7 +421,7 @@ void Simulation::rebuild_if_needed() {
 }
 
 void Simulation::rebuild(double proximity) {
-  if (live_records_ready_) sync_live_records();  // (the rows are made anew, their history by key)
+  if (live_.records_ready()) live_.sync_records(contacts);  // (the rows are made anew, their history by key)
   // A ball that has flown off to infinity (a blow-up: Δt too large, or a state that cannot be
   // integrated) has no cell: stop here with the ball and the step, as the force pass does for a
   // non-finite force (which would come only after the list). Every list is made here, and a
@@ -533,7 +529,7 @@ void Simulation::build_row_lists() {
     if (k.kind == ContactKind::BallBall) late_rows_[late_fill[k.b]++] = static_cast<std::uint32_t>(c);
   }
   share_moment_.assign(rows, Vec3{});
-  live_ready_ = false;  // (new rows)
+  live_.invalidate();  // (new rows)
   ball_k_tran_.assign(n, 0.0);
   ball_k_rot_.assign(n, 0.0);
   stiffness_ready_ = false;
@@ -901,7 +897,7 @@ void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
     for (; lane + 8 <= n; lane += 8) {
       if (_mm512_cmp_epi64_mask(widen8(batch.slots() + lane), no_slot, _MM_CMPINT_NE) != 0xFF) break;  // (the rest lane by lane)
       __m512d r[8], c[8];
-      for (std::size_t k = 0; k < 8; ++k) r[k] = _mm512_load_pd(reinterpret_cast<const double*>(&live_records_[batch.slot(lane + k)]));
+      for (std::size_t k = 0; k < 8; ++k) r[k] = _mm512_load_pd(reinterpret_cast<const double*>(&live_.records()[batch.slot(lane + k)]));
       transpose8(r, c);  // c[1]: set and flags; c[2..4]: n̂_c; c[5..7]: F^h_s
       const F::Field history[6] = {F::kNox, F::kNoy, F::kNoz, F::kSx, F::kSy, F::kSz};
       for (int f = 0; f < 6; ++f) _mm512_store_pd(batch.col(history[f]) + lane, c[2 + f]);
@@ -921,7 +917,7 @@ void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
     if (hill) {
       const std::uint32_t slot = batch.slot(lane);
       if (slot != ContactBatch::kNoSlot) {
-        const LiveRecord& r = live_records_[slot];
+        const LiveRecord& r = live_.records()[slot];
         put_hill(lane, r.normal, r.shear, r.hill_set, r.moisture);
       } else {
         put_hill(lane, contacts.normal[c], contacts.shear_state[c], row_hill_set_[c], contacts.moisture[c]);
@@ -971,8 +967,8 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
   constexpr std::size_t kPrefetchBalls = 8;
   constexpr std::size_t kPrefetchRecords = 64;
   const bool far = contacts.size() > (std::size_t{1} << 17);
-  const bool live = live_now_;  // the rows visited: the live rows (force_pass), or all (through force_row)
-  const bool records = live && live_records_ready_;  // the live rows through their records
+  const bool live = live_.visited();  // the rows visited: the live rows (force_pass), or all (through force_row)
+  const bool records = live && live_.records_ready();  // the live rows through their records
   using F = ContactBatch;
   ContactBatch& hill = scratch.hill;
   ContactBatch& linear = scratch.linear;
@@ -1019,12 +1015,12 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
         RowShare share;
         store_row(c, lane_outcome(batch, lane, /*wall_row=*/false), want_stiffness, reported, share);
         add_share(c, share);
-        if (slot != ContactBatch::kNoSlot) load_live_record(slot);  // (store_row wrote the columns)
+        if (slot != ContactBatch::kNoSlot) live_.load_record(slot, contacts, row_hill_set_.data());  // (store_row wrote the columns)
         return;
       }
       // The shares from the lanes; a live record's history into the record.
       if (slot != ContactBatch::kNoSlot) {
-        LiveRecord& h = live_records_[slot];
+        LiveRecord& h = live_.records()[slot];
         h.shear = batch.get3(F::kShx, lane);
         h.normal = batch.get3(F::kNx, lane);
         if (batch.col(F::kRuptured)[lane] != 0.0) h.moisture = Moisture::Ruptured;
@@ -1079,7 +1075,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
           _mm512_store_pd(a, _mm512_add_pd(_mm512_load_pd(a), share_a[k]));
           double* b = reinterpret_cast<double*>(sums + batch.ball2(lane + k));
           _mm512_store_pd(b, _mm512_add_pd(_mm512_load_pd(b), share_b[k]));
-          _mm512_mask_store_pd(reinterpret_cast<double*>(&live_records_[batch.slot(lane + k)]), 0xFC, history[k]);
+          _mm512_mask_store_pd(reinterpret_cast<double*>(&live_.records()[batch.slot(lane + k)]), 0xFC, history[k]);
         }
       }
     }
@@ -1107,7 +1103,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
         __builtin_prefetch(sums + ahead, 1);
       }
       // Its row range: of its live rows, or of all its rows.
-      __builtin_prefetch(live ? live_first_.data() + ahead : first_rows_.data() + ahead);
+      __builtin_prefetch(live ? live_.first() + ahead : first_rows_.data() + ahead);
     }
     // Ball a's rows from the last down: k1 − 1 down to k0 of the row sequence row_at, its live rows
     // (live_rows) or all of its rows.
@@ -1186,8 +1182,9 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
       // run_rows for live rows, with the record of each row in place of its nine columns. A row that
       // is no contact (a neighbour pair within reach of one, or a contact deleted since the list)
       // is checked for reach from the record and its second ball's, which the lanes read anyway.
-      LiveRecord* rec = live_records_.data();
-      for (std::size_t k = live_first_[a + 1]; k-- > live_first_[a];) {
+      LiveRecord* rec = live_.records();
+      const std::uint32_t* live_first = live_.first();
+      for (std::size_t k = live_first[a + 1]; k-- > live_first[a];) {
         if (far) {
           // The neighbour's record and sums, as in run_rows (24 rows ahead the same as 16), and the
           // record 64 rows on (one line a row; 32-128 rows alike, 16 slower). Asked for to be read,
@@ -1217,7 +1214,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
           if (!exists && within_reach(ka, b, r.image)) [[unlikely]] {  // a contact again (force_row)
             if (hill.size() > 0) flush(hill);
             add_share(c, force_row(c, dt));
-            load_live_record(k);
+            live_.load_record(k, contacts, row_hill_set_.data());
           }
           continue;
         }
@@ -1225,8 +1222,8 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
         run_rows(k + 1, k, [rec](std::size_t j) -> std::size_t { return rec[j].row; });
       }
     } else if (live) {
-      const std::uint32_t* rows = live_rows_.data();
-      run_rows(live_first_[a + 1], live_first_[a], [rows](std::size_t k) -> std::size_t { return rows[k]; });
+      const std::uint32_t* rows = live_.rows();
+      run_rows(live_.first()[a + 1], live_.first()[a], [rows](std::size_t k) -> std::size_t { return rows[k]; });
     } else {  // every row through force_row (each contact's shear displacement tracked)
       for (std::size_t c = first_rows_[a + 1]; c-- > first_rows_[a];) add_share(c, force_row(c, dt));
     }
@@ -1301,98 +1298,7 @@ void Simulation::wall_block(std::size_t k0, std::size_t k1, double dt, BlockScra
 }
 
 void Simulation::refresh_live_rows() {
-  // The slack s: the list is made again when any ball has moved more than s since; it holds the
-  // neighbour pairs within proximity + 2 s. A list that lasted fewer than kLiveShort passes doubles
-  // it (fast balls: fewer remakes, more pairs checked), one that lasted more than kLiveLong halves it
-  // (slow balls), between a thousandth and a quarter of the skin. The list changes no result, only
-  // how much the row loop visits; so neither does s.
-  constexpr std::int64_t kLiveShort = 25, kLiveLong = 400;
-  if (live_records_ready_) sync_live_records();  // (made for the old list)
-  const double skin_now = skin();
-  const std::int64_t lasted = live_passes_;
-  if (!(live_slack_ > 0.0) || live_slack_ > 0.25 * skin_now) live_slack_ = 0.002 * skin_now;
-  else if (live_ready_ && lasted < kLiveShort) live_slack_ = std::min(2.0 * live_slack_, 0.25 * skin_now);
-  else if (live_ready_ && lasted > kLiveLong) live_slack_ = std::max(0.5 * live_slack_, 0.001 * skin_now);
-  live_passes_ = 0;
-  const std::size_t n = balls.size();
-  const double proximity = settings.proximity;
-  const double slack = live_slack_;
-  // Each ball-ball row is live if it is a contact, not a hill row, or a hill neighbour pair within
-  // proximity + 2 s (with a margin of 1e-9 of the radii, far above the rounding of the distances and
-  // of the travel). Such a pair was once kept apart, as a near row that sent its ball through all
-  // its rows once it became a contact; as a live row it costs its record, and each new contact no
-  // more than its own row (docs/performance.md, twenty-first session).
-  auto is_live = [&](std::size_t c) -> std::uint8_t {
-    if (contacts.exists[c] || contacts.model[c] != ModelKind::Hill) return 1;
-    const ContactKey& k = contacts.key[c];
-    Vec3 xb = ball_kin_[k.b].position;
-    if (contacts.image[c] != kNoImage) xb += image_shift(contacts.image[c], settings.box);
-    const double radii = ball_kin_[k.a].radius + ball_kin_[k.b].radius;
-    const double reach = (radii + proximity + 2.0 * slack) * (1.0 + 1e-9);
-    return norm2(xb - ball_kin_[k.a].position) > reach * reach ? 0 : 1;
-  };
-  std::vector<std::uint8_t> live(contacts.size(), 0);
-  live_first_.assign(n + 1, 0);
-#pragma omp parallel for schedule(static) if (n > kParallelMin)
-  for (std::size_t a = 0; a < n; ++a) {
-    std::uint32_t count = 0;
-    for (std::size_t c = first_rows_[a]; c < first_rows_[a + 1]; ++c) count += live[c] = is_live(c);
-    live_first_[a + 1] = count;
-  }
-  for (std::size_t a = 0; a < n; ++a) live_first_[a + 1] += live_first_[a];
-  live_rows_.resize(live_first_[n]);
-#pragma omp parallel for schedule(static) if (n > kParallelMin)
-  for (std::size_t a = 0; a < n; ++a) {
-    std::uint32_t l = live_first_[a];
-    for (std::size_t c = first_rows_[a]; c < first_rows_[a + 1]; ++c)
-      if (live[c]) live_rows_[l++] = static_cast<std::uint32_t>(c);
-  }
-  position_at_live_.resize(n);
-  for (std::size_t i = 0; i < n; ++i) position_at_live_[i] = ball_kin_[i].position;
-  live_travel_ = 0.0;
-  live_bound_valid_ = true;
-  live_proximity_ = settings.proximity;
-  live_rows_of_ = contacts.size();
-  live_ready_ = true;
-  ++live_refreshes_;
-}
-
-void Simulation::load_live_record(std::size_t k) {
-  LiveRecord& r = live_records_[k];
-  const std::size_t c = r.row;
-  r.b = contacts.key[c].b;
-  r.hill_set = row_hill_set_[c];
-  r.image = contacts.image[c];
-  r.exists = contacts.exists[c];
-  r.model = contacts.model[c];
-  r.moisture = contacts.moisture[c];
-  r.normal = contacts.normal[c];
-  r.shear = contacts.shear_state[c];
-}
-
-void Simulation::build_live_records() {
-  live_records_.resize(live_rows_.size());
-  const std::size_t n = balls.size();
-#pragma omp parallel for schedule(static) if (n > kParallelMin)
-  for (std::size_t a = 0; a < n; ++a)
-    for (std::size_t k = live_first_[a]; k < live_first_[a + 1]; ++k) {
-      live_records_[k].row = live_rows_[k];
-      load_live_record(k);
-    }
-  live_records_ready_ = true;
-}
-
-void Simulation::write_back(const LiveRecord& r) {
-  if (r.model != ModelKind::Hill) return;  // (other models keep theirs in the columns)
-  contacts.normal[r.row] = r.normal, contacts.shear_state[r.row] = r.shear;
-  contacts.moisture[r.row] = r.moisture;
-}
-
-void Simulation::sync_live_records() {
-  const std::size_t live = live_records_.size();
-#pragma omp parallel for schedule(static) if (live > kParallelMin)
-  for (std::size_t k = 0; k < live; ++k) write_back(live_records_[k]);
-  live_records_ready_ = false;
+  live_.refresh(contacts, ball_kin_.data(), first_rows_.data(), balls.size(), settings.proximity, settings.box, skin());
 }
 
 void Simulation::force_pass(double dt) {
@@ -1443,19 +1349,20 @@ void Simulation::force_pass(double dt) {
   // (rebuild_if_needed measured it), or the rows, their models or the proximity may have changed. (A
   // contact made since, in any pass, was a live row: the others were too far apart to touch.) Not
   // while each contact's shear displacement is tracked: every row then goes through force_row.
-  live_now_ = !settings.track_shear_displacement;
-  if (!terms_ready || live_rows_of_ != rows || !(live_proximity_ == settings.proximity)) live_ready_ = false;
-  if (live_now_ && !(live_ready_ && live_travel_known_ && live_travel_ <= live_slack_)) refresh_live_rows();
-  live_travel_known_ = false;  // (measured again before the next pass)
+  live_.set_visited(!settings.track_shear_displacement);
+  if (!terms_ready || !live_.made_for(rows, settings.proximity)) live_.invalidate();
+  if (live_.visited() && !live_.current()) refresh_live_rows();
+  live_.end_pass_measure();
   // The live rows through their records on the steps nobody looks at, made when
   // at least kRecordSteps more steps follow in this cycle() call: making them and writing them back
   // cost about half a step at 100,800 spheres (calls of 9 steps gave 1.021 x against 1.084 x for calls
   // of 200), which ≈ 1.08 x a step wins back in about eight steps.
   constexpr std::int64_t kRecordSteps = 8;
-  const bool records = live_now_ && !write_results_;
-  if (live_records_ready_ && !records) sync_live_records();
-  if (records && !live_records_ready_ && steps_ahead_ >= kRecordSteps) build_live_records();
-  live_record_passes_ += live_records_ready_;
+  const bool records = live_.visited() && !write_results_;
+  if (live_.records_ready() && !records) live_.sync_records(contacts);
+  if (records && !live_.records_ready() && steps_ahead_ >= kRecordSteps)
+    live_.build_records(contacts, row_hill_set_.data(), n);
+  live_.count_record_pass();
   std::unique_ptr<std::atomic<bool>[]> crossing_done;  // per thread: its crossing list is final
   std::atomic<bool> late_share{false};
 #pragma omp parallel reduction(min : bad_row) reduction(+ : batched) if (n > kParallelMin)
@@ -1467,9 +1374,9 @@ void Simulation::force_pass(double dt) {
 #pragma omp single
     {
       const auto threads = static_cast<std::size_t>(omp_get_num_threads());
-      const bool live_split = live_now_ && live_ready_ && live_first_.size() == n + 1;
+      const bool live_split = live_.visited() && live_.covers(n);
       const bool resplit = split_.prepare(threads, n, rows, thread_shares,
-                                          live_split ? live_first_.data() : first_rows_.data(), wall_rows_start_.data());
+                                          live_split ? live_.first() : first_rows_.data(), wall_rows_start_.data());
       crossing_.resize(threads);
       if (resplit || crossing_floor_.size() != threads) crossing_floor_.assign(threads, kFloorUnknown);
       crossing_done.reset(new std::atomic<bool>[threads]);
@@ -1532,7 +1439,7 @@ void Simulation::force_pass(double dt) {
   if (late_share.load()) throw RunError("internal error: a crossing share after its list was final (force_pass)");
   batched_rows_ = batched;
   body_terms_ready_ = true;
-  ++live_passes_;
+  live_.count_pass();
   if (bad_row < rows) {
     const ContactKey& key = contacts.key[bad_row];
     std::ostringstream msg;

@@ -19,7 +19,9 @@
 #include "hilldem/bodies/ball_store.hpp"
 #include "hilldem/bodies/wall_store.hpp"
 #include "hilldem/contact/contact_store.hpp"
+#include "hilldem/engine/ball_kin.hpp"
 #include "hilldem/engine/contact_batch.hpp"
+#include "hilldem/engine/live_rows.hpp"
 #include "hilldem/engine/work_split.hpp"
 #include "hilldem/models/model_table.hpp"
 #include "hilldem/motion/ball_step.hpp"
@@ -115,9 +117,9 @@ class Simulation {
   // How often the live rows were made (the rows the force pass visits: contacts, rows of other models
   // than hill, and the hill neighbour pairs within proximity + 2 s when the list was made; remade when
   // a ball has moved more than the slack s since).
-  std::int64_t live_row_refreshes() const { return live_refreshes_; }
+  std::int64_t live_row_refreshes() const { return live_.refreshes(); }
   // How many force passes ran through the live records.
-  std::int64_t live_record_passes() const { return live_record_passes_; }
+  std::int64_t live_record_passes() const { return live_.record_passes(); }
   // Given shares of the work per thread (one per thread, normalised) instead of those measured from
   // the threads' speeds: for tests, and for cores of known speeds. Results do not depend on them.
   std::vector<double> thread_shares;
@@ -313,15 +315,6 @@ class Simulation {
   // the forces), valid while stiffness_ready_.
   std::vector<double> ball_k_tran_, ball_k_rot_;
   bool stiffness_ready_ = false;
-  struct alignas(64) BallKin {
-    Vec3 position;         // [m]
-    double radius = 0.0;   // [m]
-    Vec3 velocity;         // [m/s]
-    Vec3 spin;             // [rad/s]
-    HillBodyTerms terms;   // for the hill mappings
-    double mass = 0.0;     // [kg] and [kg m²]: for the record motion (in the record's last 16 bytes,
-    double inertia = 0.0;  // which the pair loop does not read)
-  };
   std::vector<BallKin> ball_kin_;             // per ball, what the batched pair loop reads
   // The records' position, velocity and spin are the balls' state: from the force pass's copy on,
   // and through the record motion of the steps that follow within one cycle() call. The columns
@@ -367,52 +360,10 @@ class Simulation {
   bool hill_sets_stale_ = true;  // (set by create_contact from the pass's threads: std::atomic_ref)
   void refresh_param_sets();
   std::vector<double> scaled_mass_, scaled_inertia_;  // density scaling [kg], [kg m²]
-  // The live rows: per ball (live_first_, as first_rows_), in row order, its
-  // ball-ball rows that were live when the list was made (refresh_live_rows), at the positions
-  // position_at_live_ [m]: contacts, rows of other models, and hill neighbour pairs within
-  // proximity + 2 live_slack_ [m]. While no ball has moved more than live_slack_ since, a pair not on
-  // the list is still beyond proximity, so new contacts come only from live rows.
-  std::vector<std::uint32_t> live_rows_;
-  std::vector<std::uint32_t> live_first_;
-  std::vector<Vec3> position_at_live_;
-  double live_slack_ = 0.0;
-  std::size_t live_rows_of_ = 0;   // rows when the list was made
-  double live_proximity_ = 0.0;    // [m] the proximity then
-  std::int64_t live_passes_ = 0;   // force passes since
-  std::int64_t live_refreshes_ = 0;
-  bool live_ready_ = false;
-  bool live_now_ = false;          // this force pass visits the live rows
-  // [m] the largest travel of a ball since the list, or a bound on it carried from step to step
-  // (valid while live_bound_valid_): exact where it was last measured ball by ball (rebuild_if_needed,
-  // advance_records), then grown by each record motion by its largest |V| Δt (live_growth_, the last
-  // step's), as travel_bound_ is. advance_records measures ball by ball only when the bound, grown by
-  // a few more such steps, would pass the slack.
-  double live_travel_ = 0.0, live_growth_ = 0.0;
-  bool live_bound_valid_ = false;
-  bool live_travel_known_ = false; // measured for this pass
+  // The rows the force pass visits, and their records (engine/live_rows.hpp).
+  LiveRows live_;
   void refresh_live_rows();
-  // The live rows' records, in live-row order (live_rows_), one cache line each:
-  // what the row loop and the lanes read and write of a row. n̂_c, F^h_s and M are those of hill rows
-  // only (other models keep theirs in the columns, and their `exists` is read there too).
-  struct alignas(64) LiveRecord {
-    std::uint32_t row = 0, b = 0;  // the row; its second ball
-    std::uint32_t hill_set = 0;    // row_hill_set_
-    ImageCode image = kNoImage;
-    std::uint8_t exists = 0;
-    ModelKind model = ModelKind::Hill;
-    Moisture moisture = Moisture::Dry;
-    Vec3 normal;  // n̂_c of the last step
-    Vec3 shear;   // F^h_s [N]
-  };
-  static_assert(sizeof(LiveRecord) == 64);
-  std::vector<LiveRecord> live_records_;
-  bool live_records_ready_ = false;   // the records hold the live hill rows' history
-  std::int64_t steps_ahead_ = 0;      // steps of the current cycle() call after this one
-  std::int64_t live_record_passes_ = 0;
-  void build_live_records();
-  void load_live_record(std::size_t k);  // record k from the columns
-  void sync_live_records();              // the history back into the columns; the records dropped
-  void write_back(const LiveRecord& r);  // one record's history (hill rows) into the columns
+  std::int64_t steps_ahead_ = 0;  // steps of the current cycle() call after this one
 };
 
 }  // namespace hilldem
