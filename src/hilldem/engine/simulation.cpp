@@ -138,8 +138,8 @@ void Simulation::step_body(bool last) {
       for (const Vec3& v : w.vertex) reach = std::max(reach, norm(v - w.rotation_center));
     else if (w.shape == WallShape::Plane && norm2(w.spin) > 0.0)
       reach = std::numeric_limits<double>::infinity();
-    if (norm2(w.spin) > 0.0) wall_travel_ += norm(w.spin) * dt * reach;
-    wall_travel_ += (norm(w.velocity) + std::abs(w.radial_velocity)) * dt;
+    if (norm2(w.spin) > 0.0) neighbours_.add_wall_travel(norm(w.spin) * dt * reach);
+    neighbours_.add_wall_travel((norm(w.velocity) + std::abs(w.radial_velocity)) * dt);
     advance_wall(w, dt);
   }
   rebuild_if_needed();  // step 3
@@ -178,10 +178,6 @@ ContactGeometry Simulation::geometry(std::size_t c) const {
   }
   g.point = x1 + g.normal * (r1 + 0.5 * g.gap);  // centre of the gap/overlap (spec §1.1)
   return g;
-}
-
-std::uint64_t Simulation::piece2_groups(const ContactKey& k) const {
-  return k.kind == ContactKind::BallBall ? balls.groups[k.b] : walls.walls[k.b].groups;
 }
 
 void Simulation::compute_mapping(ContactStore& store, std::size_t c) const {
@@ -252,26 +248,13 @@ void Simulation::refresh_mappings() {
   for (std::size_t c = 0; c < contacts.size(); ++c) compute_mapping(contacts, c);
 }
 
-void Simulation::wrap_positions() {
-  const PeriodicBox& box = settings.box;
-  if (!box.any()) return;
-  const Vec3 l = box.length();
-  for (Vec3& x : balls.position)
-    for (int d = 0; d < 3; ++d)
-      if (box.periodic[d]) {
-        x[d] = box.lo[d] + std::fmod(x[d] - box.lo[d], l[d]);
-        if (x[d] < box.lo[d]) x[d] += l[d];
-        if (x[d] >= box.hi[d]) x[d] -= l[d];
-      }
-}
-
 void Simulation::advance_records(double dt, const double* inertial_mass, const double* inertial_inertia,
                                  bool write_columns) {
   // One pass over the balls where there were three (the law of motion on the columns, the travel
   // check, the force pass's copy into the records), ≈ 660 bytes streamed a ball a step against ≈ 420
   // here: 1.04 x at 100,800 spheres (docs/performance.md, fifteenth session). The law is
   // advance_balls's (motion::step_ball). The travel since the live rows is measured ball by ball (the
-  // check's expression); that since the neighbour list only bounded (travel_bound_, no reference
+  // check's expression); that since the neighbour list only bounded (NeighbourList::travel_bound, no reference
   // position read), exactly by rebuild_if_needed when the bound reaches half the skin.
   using namespace motion;
   const std::size_t n = balls.size();
@@ -352,8 +335,7 @@ void Simulation::advance_records(double dt, const double* inertial_mass, const d
   // No ball moved farther than |V|max Δt this step, but for the rounding of x + V Δt (below
   // 2.3e-16 |x| a step) and of |V|: a margin of 1e-9 of the first and 1e-15 |x|max [m]. A NaN stays.
   const double growth = std::sqrt(max_v2) * dt * (1.0 + 1e-9) + 1e-15 * std::sqrt(max_x2);
-  travel_bound_ += growth;
-  motion_travel_known_ = true;
+  neighbours_.grow_travel_bound(growth);
   live_.after_motion(live_list, live, bounded, worst_live, growth);
 }
 
@@ -371,9 +353,8 @@ void Simulation::sync_ball_columns() {
 }
 
 void Simulation::rebuild_if_needed() {
-  const bool measured = motion_travel_known_;  // by advance_records, this step
-  motion_travel_known_ = false;
-  if (!rebuild_needed_ && position_at_build_.size() == balls.size()) {
+  const bool measured = neighbours_.take_motion_bound();  // by advance_records, this step
+  if (!neighbours_.stale(balls.size())) {
     if (records_current_ && !skin_known_) {  // (the radii stay until the records are dropped)
       skin_ = skin();
       skin_known_ = true;
@@ -382,15 +363,16 @@ void Simulation::rebuild_if_needed() {
     // A pair outside the list was farther than `skin` beyond proximity at the rebuild. The record
     // motion's bound first: the exact travel is at most the bound, so a bound within the limit gives
     // the exact check's answer without a pass over the positions (a NaN bound fails, and goes on).
-    if (measured && travel_bound_ <= half && travel_bound_ + wall_travel_ <= 2.0 * half) return;
+    if (measured && neighbours_.holds(neighbours_.travel_bound(), half)) return;
     // The largest squared travel since the rebuild [m²], exactly; a NaN wins (not std::max, which
-    // would drop it). Parallel: the maximum does not depend on the order, and a NaN asks for a rebuild,
-    // which ends the run (rebuild). And the largest since the live rows were made (refresh_live_rows), while they are. (The
-    // positions from the records when the columns lag behind them.)
+    // would drop it). Parallel: the maximum does not depend on the order, and a NaN asks for a
+    // rebuild, which ends the run (NeighbourList::rebuild). And the largest since the live rows were
+    // made, while they are. (The positions from the records when the columns lag behind them.)
     const std::size_t n = balls.size();
     const bool from_records = columns_stale_;
     const bool live = live_.has_positions(n);
     const Vec3* at_live = live_.positions();
+    const Vec3* at_build = neighbours_.position_at_build().data();
     double worst = 0.0, worst_live = 0.0;
 #pragma omp parallel if (n > kParallelMin)
     {
@@ -398,7 +380,7 @@ void Simulation::rebuild_if_needed() {
 #pragma omp for schedule(static) nowait
       for (std::size_t i = 0; i < n; ++i) {
         const Vec3& x = from_records ? ball_kin_[i].position : balls.position[i];
-        const double d2 = norm2(x - position_at_build_[i]);
+        const double d2 = norm2(x - at_build[i]);
         if (!(d2 <= mine)) mine = d2;
         if (live) {
           const double l2 = norm2(x - at_live[i]);
@@ -413,8 +395,8 @@ void Simulation::rebuild_if_needed() {
     }
     live_.measured(live, worst_live);
     const double ball_travel = std::sqrt(worst);
-    travel_bound_ = ball_travel;  // (exact now: the record motion grows it from here)
-    if (ball_travel <= half && ball_travel + wall_travel_ <= 2.0 * half) return;
+    neighbours_.set_travel_bound(ball_travel);  // (exact now: the record motion grows it from here)
+    if (neighbours_.holds(ball_travel, half)) return;
   }
   drop_records();  // the rebuild reads the columns, and wraps the positions into a periodic box
   rebuild(settings.proximity);
@@ -422,121 +404,29 @@ void Simulation::rebuild_if_needed() {
 
 void Simulation::rebuild(double proximity) {
   if (live_.records_ready()) live_.sync_records(contacts);  // (the rows are made anew, their history by key)
-  // A ball that has flown off to infinity (a blow-up: Δt too large, or a state that cannot be
-  // integrated) has no cell: stop here with the ball and the step, as the force pass does for a
-  // non-finite force (which would come only after the list). Every list is made here, and a
-  // non-finite travel (rebuild_if_needed) always asks for one. Before the wrap, so that the message
-  // gives the position the run reached.
-  for (std::size_t i = 0; i < balls.size(); ++i) {
-    const Vec3& x = balls.position[i];
-    if (!std::isfinite(norm2(x) + balls.radius[i]))  // (|x|² overflows too: no distance is finite then)
-      throw RunError("ball " + std::to_string(balls.id[i]) + " has a non-finite position at step " +
-                     std::to_string(steps) + " (" + std::to_string(x.x) + ", " + std::to_string(x.y) + ", " +
-                     std::to_string(x.z) + " m): the run is unstable; reduce the time step");
-  }
-  wrap_positions();
   const double reach = proximity + skin();
-  std::vector<PairCandidate> candidates = find_pair_candidates(balls.position, balls.radius, reach, settings.box);
-  std::vector<ContactKey> keys;
-  keys.reserve(candidates.size());
-  for (const PairCandidate& p : candidates) keys.push_back({p.i, ContactKind::BallBall, p.j});
-  std::vector<std::pair<ContactKey, ImageCode>> wall_keys;
-  for (std::uint32_t w = 0; w < walls.size(); ++w)
-    for (std::uint32_t i = 0; i < balls.size(); ++i) {
-      const auto touch = wall_touch(walls.walls[w], balls.position[i], balls.radius[i]);
-      if (touch && touch->gap <= reach) wall_keys.push_back({{i, ContactKind::BallWall, w}, kNoImage});
-    }
-  // Merge the two candidate lists into one sorted list (ball-ball keys are already sorted).
-  std::vector<std::pair<ContactKey, ImageCode>> all;
-  all.reserve(keys.size() + wall_keys.size());
-  for (std::size_t k = 0; k < keys.size(); ++k) all.push_back({keys[k], candidates[k].image});
-  all.insert(all.end(), wall_keys.begin(), wall_keys.end());
-  std::sort(all.begin(), all.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
-
-  // Merge with the existing rows (also sorted): history survives. An old row that is no longer a
-  // candidate is kept only while it must be: a wet hill contact (spec §2.5).
-  ContactStore next;
-  next.key.reserve(all.size());
-  unassigned_pairs_ = 0;
-  std::size_t o = 0;
-  auto keep_old_if_needed = [&](std::size_t i) {
-    if (contacts.exists[i] && contacts.model[i] == ModelKind::Hill && contacts.moisture[i] == Moisture::Wet) {
-      next.append_row(contacts, i);
-      const ContactKey& k = contacts.key[i];
-      if (k.kind == ContactKind::BallBall)
-        next.image.back() = nearest_image(balls.position[k.a], balls.position[k.b], settings.box);
-    }
-  };
-  for (const auto& [key, image] : all) {
-    while (o < contacts.size() && contacts.key[o] < key) keep_old_if_needed(o++);
-    if (o < contacts.size() && contacts.key[o] == key) {
-      next.append_row(contacts, o++);
-      next.image.back() = image;
-      continue;
-    }
-    const int r = table.match(key.kind, balls.groups[key.a], piece2_groups(key));
-    if (r < 0) {
-      ++unassigned_pairs_;
-      continue;
-    }
-    const ModelRule& rule = table.rules[r];
-    next.append_new(key, image, r, rule.model, rule.linear, rule.hill, Vec3{0, 0, 1});
-    compute_mapping(next, next.size() - 1);
-  }
-  while (o < contacts.size()) keep_old_if_needed(o++);
-  contacts = std::move(next);
+  neighbours_.rebuild(contacts, balls, walls, table, settings.box, reach, steps,
+                      [this](ContactStore& store, std::size_t c) { compute_mapping(store, c); });
   build_row_lists();
-  position_at_build_ = balls.position;
-  travel_bound_ = 0.0;
-  wall_travel_ = 0.0;
-  rebuild_needed_ = false;
+  neighbours_.built(balls.position);
   body_terms_ready_ = false;
-  ++rebuilds_;
 }
 
 void Simulation::build_row_lists() {
-  // The per-ball row lists of the force sum (see first_rows_, late_rows_, wall_rows_), in row order.
-  const std::size_t n = balls.size();
-  const std::size_t rows = contacts.size();
-  if (rows > static_cast<std::size_t>(std::numeric_limits<std::uint32_t>::max()))
-    throw RunError("too many neighbour pairs (" + std::to_string(rows) + ") for one process");
-  crossing_floor_.clear();  // (made again from these rows: force_pass)
-  first_rows_.assign(n + 1, 0);
-  late_rows_start_.assign(n + 1, 0);
-  wall_rows_start_.assign(n + 1, 0);
-  wall_rows_.clear();
-  row_span_ = 0;
-  for (std::size_t c = 0; c < rows; ++c) {
-    const ContactKey& k = contacts.key[c];
-    if (k.kind == ContactKind::BallBall) {
-      if (k.b > k.a) row_span_ = std::max<std::size_t>(row_span_, k.b - k.a);
-      ++first_rows_[k.a + 1];
-      ++late_rows_start_[k.b + 1];
-    } else {
-      wall_rows_.push_back(static_cast<std::uint32_t>(c));  // (sorted by ball: keys by kind, then a)
-      ++wall_rows_start_[k.a + 1];
-    }
-  }
-  for (std::size_t i = 0; i < n; ++i) {
-    first_rows_[i + 1] += first_rows_[i];
-    late_rows_start_[i + 1] += late_rows_start_[i];
-    wall_rows_start_[i + 1] += wall_rows_start_[i];
-  }
-  late_rows_.assign(late_rows_start_[n], 0);
-  std::vector<std::uint32_t> late_fill(late_rows_start_.begin(), late_rows_start_.end() - 1);
-  for (std::size_t c = 0; c < rows; ++c) {
-    const ContactKey& k = contacts.key[c];
-    if (k.kind == ContactKind::BallBall) late_rows_[late_fill[k.b]++] = static_cast<std::uint32_t>(c);
-  }
-  share_moment_.assign(rows, Vec3{});
-  live_.invalidate();  // (new rows)
-  ball_k_tran_.assign(n, 0.0);
-  ball_k_rot_.assign(n, 0.0);
+  neighbours_.build_row_lists(contacts, balls.size());
+  // What the force pass keeps per row or per ball of these rows, made again.
+  crossing_floor_.clear();
+  share_moment_.assign(contacts.size(), Vec3{});
+  live_.invalidate();
+  ball_k_tran_.assign(balls.size(), 0.0);
+  ball_k_rot_.assign(balls.size(), 0.0);
   stiffness_ready_ = false;
 }
 
 CycleState Simulation::cycle_state() const {
-  return {forces_ready_, rebuild_needed_, rebuilds_, unassigned_pairs_, position_at_build_, wall_travel_};
+  const NeighbourList& list = neighbours_;
+  return {forces_ready_,         list.rebuild_needed(),    list.rebuilds(), list.unassigned_pairs(),
+          list.position_at_build(), list.wall_travel()};
 }
 
 void Simulation::restore_cycle_state(CycleState s) {
@@ -547,17 +437,15 @@ void Simulation::restore_cycle_state(CycleState s) {
     if (k.a >= balls.size() || (k.kind == ContactKind::BallBall && k.b >= balls.size()) ||
         (k.kind == ContactKind::BallWall && k.b >= walls.size()))
       throw RunError("cycle state: a contact row refers to a body that does not exist");
-  // The force pass finds a ball's rows by position in the sorted list (first_rows_).
+  // The force pass finds a ball's rows by position in the sorted list (NeighbourList::first_rows).
   for (std::size_t c = 1; c < contacts.size(); ++c)
     if (!(contacts.key[c - 1] < contacts.key[c])) throw RunError("cycle state: contact rows are not sorted by key");
   forces_ready_ = s.forces_ready;
   sums_current_ = false;  // the restored columns hold the sums the next step moves with
   sum_columns_stale_ = false;
-  rebuild_needed_ = s.rebuild_needed || s.position_at_build.empty();
-  rebuilds_ = s.rebuilds;
-  unassigned_pairs_ = static_cast<std::size_t>(s.unassigned_pairs);
-  position_at_build_ = std::move(s.position_at_build);
-  wall_travel_ = s.wall_travel;
+  const bool rebuild_needed = s.rebuild_needed || s.position_at_build.empty();  // (before the move below)
+  neighbours_.restore(rebuild_needed, s.rebuilds, static_cast<std::size_t>(s.unassigned_pairs),
+                      std::move(s.position_at_build), s.wall_travel);
   body_terms_ready_ = false;
   build_row_lists();
 }
@@ -1103,7 +991,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
         __builtin_prefetch(sums + ahead, 1);
       }
       // Its row range: of its live rows, or of all its rows.
-      __builtin_prefetch(live ? live_.first() + ahead : first_rows_.data() + ahead);
+      __builtin_prefetch(live ? live_.first() + ahead : neighbours_.first_rows().data() + ahead);
     }
     // Ball a's rows from the last down: k1 − 1 down to k0 of the row sequence row_at, its live rows
     // (live_rows) or all of its rows.
@@ -1225,7 +1113,8 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
       const std::uint32_t* rows = live_.rows();
       run_rows(live_.first()[a + 1], live_.first()[a], [rows](std::size_t k) -> std::size_t { return rows[k]; });
     } else {  // every row through force_row (each contact's shear displacement tracked)
-      for (std::size_t c = first_rows_[a + 1]; c-- > first_rows_[a];) add_share(c, force_row(c, dt));
+      const std::vector<std::uint32_t>& first_rows = neighbours_.first_rows();
+      for (std::size_t c = first_rows[a + 1]; c-- > first_rows[a];) add_share(c, force_row(c, dt));
     }
   }
   if (hill.size() > 0) flush(hill);
@@ -1263,7 +1152,7 @@ void Simulation::wall_block(std::size_t k0, std::size_t k1, double dt, BlockScra
     batch.clear();
   };
   for (std::size_t k = k0; k < k1; ++k) {
-    const std::size_t c = wall_rows_[k];
+    const std::size_t c = neighbours_.wall_rows()[k];
     if (!batched || !contacts.exists[c] || contacts.model[c] != ModelKind::Linear) {
       done(c, force_row(c, dt));
       continue;
@@ -1298,7 +1187,8 @@ void Simulation::wall_block(std::size_t k0, std::size_t k1, double dt, BlockScra
 }
 
 void Simulation::refresh_live_rows() {
-  live_.refresh(contacts, ball_kin_.data(), first_rows_.data(), balls.size(), settings.proximity, settings.box, skin());
+  live_.refresh(contacts, ball_kin_.data(), neighbours_.first_rows().data(), balls.size(), settings.proximity,
+                settings.box, skin());
 }
 
 void Simulation::force_pass(double dt) {
@@ -1308,7 +1198,7 @@ void Simulation::force_pass(double dt) {
   // row writes only its own columns. Each thread takes a range of balls of equal work
   // (WorkSplit) in blocks of balls_per_block from its start, and runs the blocks from the last
   // down. Every ball's force is summed in one order whatever the ranges: its ball-ball rows in
-  // descending row order, then its wall rows (first_rows_, force_block, collect_forces). So results
+  // descending row order, then its wall rows (NeighbourList::first_rows, force_block, collect_forces). So results
   // depend neither on the blocks (ContactBatch::pad_lanes) nor on the thread count. The first
   // failing row is found by a min-reduction, so the outcome does not depend on the thread count.
   if (ball_sums_.size() != n) ball_sums_.resize(n);
@@ -1375,8 +1265,9 @@ void Simulation::force_pass(double dt) {
     {
       const auto threads = static_cast<std::size_t>(omp_get_num_threads());
       const bool live_split = live_.visited() && live_.covers(n);
-      const bool resplit = split_.prepare(threads, n, rows, thread_shares,
-                                          live_split ? live_.first() : first_rows_.data(), wall_rows_start_.data());
+      const std::uint32_t* row_first = live_split ? live_.first() : neighbours_.first_rows().data();
+      const bool resplit =
+          split_.prepare(threads, n, rows, thread_shares, row_first, neighbours_.wall_rows_start().data());
       crossing_.resize(threads);
       if (resplit || crossing_floor_.size() != threads) crossing_floor_.assign(threads, kFloorUnknown);
       crossing_done.reset(new std::atomic<bool>[threads]);
@@ -1392,13 +1283,15 @@ void Simulation::force_pass(double dt) {
     // The lowest ball of the range with a row into a later range (made once per split: the rows do
     // not change until the next). Below it the thread adds no crossing share, and from there its list
     // is final and announced (crossing_done), long before its pass ends: the blocks run from the
-    // last down, and the crossing rows are those of its top layer of balls: only its top row_span_
-    // balls can have one, and the last range has none.
+    // last down, and the crossing rows are those of its top layer of balls: only its top row_span balls
+    // (NeighbourList::row_span) can have one, and the last range has none.
     if (crossing_floor_[t] == kFloorUnknown) {
       std::size_t floor = last;
-      if (last < n)
-        for (std::size_t a = last - std::min(last - first, row_span_); a < last && floor == last; ++a)
-          if (first_rows_[a + 1] > first_rows_[a] && contacts.key[first_rows_[a + 1] - 1].b >= last) floor = a;
+      if (last < n) {
+        const std::vector<std::uint32_t>& rows_of = neighbours_.first_rows();
+        for (std::size_t a = last - std::min(last - first, neighbours_.row_span()); a < last && floor == last; ++a)
+          if (rows_of[a + 1] > rows_of[a] && contacts.key[rows_of[a + 1] - 1].b >= last) floor = a;
+      }
       crossing_floor_[t] = floor;
     }
     const std::size_t floor = crossing_floor_[t];
@@ -1429,7 +1322,7 @@ void Simulation::force_pass(double dt) {
         if (spin > 1000) std::this_thread::yield();  // (more threads than cores: let the other run)
       add_crossing(crossing_[u], first, last);
     }
-    const std::size_t k0 = wall_rows_start_[first], k1 = wall_rows_start_[last];
+    const std::size_t k0 = neighbours_.wall_rows_start()[first], k1 = neighbours_.wall_rows_start()[last];
     if (k1 > k0) {
       wall_block(k0, k1, dt, *scratch, bad_row, batched);
       add_wall_rows(k0, k1);
@@ -1468,7 +1361,7 @@ void Simulation::add_wall_rows(std::size_t k0, std::size_t k1) {
   const bool want_stiffness = settings.auto_timestep || settings.density_scaling;
   motion::ContactSums* __restrict sums = ball_sums_.data();
   for (std::size_t k = k0; k < k1; ++k) {
-    const std::uint32_t c = wall_rows_[k];
+    const std::uint32_t c = neighbours_.wall_rows()[k];
     const std::size_t a = contacts.key[c].a;
     sums[a].force -= motion::load(contacts.force[c]);
     sums[a].moment += motion::load(share_moment_[c]);
@@ -1486,7 +1379,7 @@ void Simulation::collect_forces() {
     w.active_contacts = 0;
   }
   // Each wall row into its wall's sums, in row order.
-  for (std::uint32_t c : wall_rows_) {
+  for (std::uint32_t c : neighbours_.wall_rows()) {
     const ContactKey& k = contacts.key[c];
     if (!contacts.active[c]) continue;
     Wall& w = walls.walls[k.b];
@@ -1531,12 +1424,15 @@ void Simulation::ball_stiffness(std::size_t i, double& k_tran, double& k_rot) co
   // row order, its own rows then those where it is piece 2; then its wall rows), so the result does
   // not depend on which way it was computed (a resumed run takes this way first).
   k_tran = k_rot = 0.0;
-  if (i + 1 >= first_rows_.size()) return;  // a ball added since the last rebuild: no contacts yet
-  for (std::size_t c = first_rows_[i + 1]; c-- > first_rows_[i];) add_row_stiffness(c, balls.radius[i], k_tran, k_rot);
-  for (std::uint32_t k = late_rows_start_[i + 1]; k-- > late_rows_start_[i];)
-    add_row_stiffness(late_rows_[k], balls.radius[i], k_tran, k_rot);
-  for (std::uint32_t k = wall_rows_start_[i]; k < wall_rows_start_[i + 1]; ++k)
-    add_row_stiffness(wall_rows_[k], balls.radius[i], k_tran, k_rot);
+  const NeighbourList& list = neighbours_;
+  const std::vector<std::uint32_t>& first = list.first_rows();
+  if (i + 1 >= first.size()) return;  // a ball added since the last rebuild: no contacts yet
+  const double radius = balls.radius[i];
+  for (std::size_t c = first[i + 1]; c-- > first[i];) add_row_stiffness(c, radius, k_tran, k_rot);
+  for (std::uint32_t k = list.late_rows_start()[i + 1]; k-- > list.late_rows_start()[i];)
+    add_row_stiffness(list.late_rows()[k], radius, k_tran, k_rot);
+  for (std::uint32_t k = list.wall_rows_start()[i]; k < list.wall_rows_start()[i + 1]; ++k)
+    add_row_stiffness(list.wall_rows()[k], radius, k_tran, k_rot);
 }
 
 double Simulation::estimate_timestep() const {
@@ -1588,7 +1484,7 @@ double Simulation::mean_unbalanced_ratio() const {
 
 std::size_t Simulation::make_wet(double suction, double gap) {
   rebuild(std::max(gap, settings.proximity));  // step 1: every pair within the gap has a row
-  rebuild_needed_ = true;                       // back to the normal reach at the next cycle
+  neighbours_.invalidate();                     // back to the normal reach at the next cycle
   std::size_t wet = 0;
   for (std::size_t c = 0; c < contacts.size(); ++c) {
     if (contacts.model[c] != ModelKind::Hill) continue;

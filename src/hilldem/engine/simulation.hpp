@@ -22,6 +22,7 @@
 #include "hilldem/engine/ball_kin.hpp"
 #include "hilldem/engine/contact_batch.hpp"
 #include "hilldem/engine/live_rows.hpp"
+#include "hilldem/engine/neighbour_list.hpp"
 #include "hilldem/engine/work_split.hpp"
 #include "hilldem/models/model_table.hpp"
 #include "hilldem/motion/ball_step.hpp"
@@ -137,10 +138,10 @@ class Simulation {
   void refresh_mappings();
   // Rebuild the neighbour list before the next force evaluation (after bodies were added or moved
   // by hand, or the table changed).
-  void invalidate_neighbours() { rebuild_needed_ = true; }
+  void invalidate_neighbours() { neighbours_.invalidate(); }
   // Number of contacts (rows that exist), and of neighbour-list rebuilds so far.
   std::size_t contact_count() const { return contacts.count_existing(); }
-  std::int64_t rebuilds() const { return rebuilds_; }
+  std::int64_t rebuilds() const { return neighbours_.rebuilds(); }
   // Reorder balls along the cell grid for memory locality. Only before any contact exists.
   void sort_balls_spatially();
   // Forces are recomputed (without any shear increment) before the next cycle: call after moving
@@ -149,7 +150,7 @@ class Simulation {
     forces_ready_ = false;
     sums_current_ = false;
     body_terms_ready_ = false;
-    rebuild_needed_ = true;
+    neighbours_.invalidate();
   }
   // Detect contacts and compute forces at the current state with no motion (Δt = 0 increments).
   void update_forces();
@@ -165,14 +166,14 @@ class Simulation {
   long find_ball_ball(std::int64_t id1, std::int64_t id2) const;
   long find_ball_wall(std::int64_t ball_id, std::size_t wall) const;
   // Candidate pairs that matched no assignment rule at the last detection.
-  std::size_t unassigned_pairs() const { return unassigned_pairs_; }
+  std::size_t unassigned_pairs() const { return neighbours_.unassigned_pairs(); }
 
  private:
   // One cycle; `last`: the last of a cycle() call (its contact results are written).
   void step_once(bool last);
   void step_body(bool last);  // step_once's work (step_once syncs the columns if it throws)
   void rebuild(double reach);
-  void build_row_lists();  // per-ball row lists (CSR) and wall rows from the current rows
+  void build_row_lists();  // the neighbour list's row lists, and the force pass's per-row state
   void rebuild_if_needed();
   void force_pass(double dt);
   // The law of motion on the records, with each ball's travel since the
@@ -258,15 +259,16 @@ class Simulation {
   // bad_row: the lowest row with a non-finite force; batched: + the rows that went through a batch.
   void force_block(std::size_t a0, std::size_t a1, std::size_t range_end, double dt, BlockScratch& scratch,
                    std::vector<CrossShare>& crossing, std::size_t& bad_row, std::int64_t& batched);
-  // The wall rows wall_rows_[k0..k1): existing linear contacts that touch their wall through a linear
-  // batch (the wall's geometry given), the rest row by row (force_row). Each row's results go to its
-  // columns and share_moment_; collect_forces() sums them in row order, so the batches need no order.
+  // The wall rows k0..k1 (of NeighbourList::wall_rows): existing linear contacts that touch their
+  // wall through a linear batch (the wall's geometry given), the rest row by row (force_row). Each
+  // row's results go to its columns and share_moment_; collect_forces() sums them in row order, so
+  // the batches need no order.
   void wall_block(std::size_t k0, std::size_t k1, double dt, BlockScratch& scratch, std::size_t& bad_row,
                   std::int64_t& batched);
   // The walls' sums (the balls' sums were ended by the pass's threads: force_pass).
   void collect_forces();
-  // The shares of `list` into balls first..last-1, in list order; the wall rows wall_rows_[k0..k1)
-  // into their balls, in row order (both with their stiffness terms when those are summed).
+  // The shares of `list` into balls first..last-1, in list order; the wall rows k0..k1 into their
+  // balls, in row order (both with their stiffness terms when those are summed).
   void add_crossing(const std::vector<CrossShare>& list, std::size_t first, std::size_t last);
   void add_wall_rows(std::size_t k0, std::size_t k1);
   void compute_mapping(ContactStore& store, std::size_t c) const;
@@ -276,40 +278,26 @@ class Simulation {
   void ball_stiffness(std::size_t i, double& k_tran, double& k_rot) const;
   // Row c's terms of those sums for a ball of the given radius [m] (if the row is an active contact).
   void add_row_stiffness(std::size_t c, double radius, double& k_tran, double& k_rot) const;
-  std::uint64_t piece2_groups(const ContactKey& k) const;
   double skin() const;
-  void wrap_positions();
 
   bool forces_ready_ = false;
   bool write_results_ = true;  // this force pass writes the reported columns (step_once)
   std::int64_t batched_rows_ = 0;
-  bool rebuild_needed_ = true;
-  std::size_t unassigned_pairs_ = 0;
-  std::int64_t rebuilds_ = 0;
-  std::vector<Vec3> position_at_build_;
-  double wall_travel_ = 0.0;                 // bound on any wall point's motion since the rebuild [m]
-  std::vector<std::uint32_t> wall_rows_;     // rows of ball-wall pairs (in row order: by ball)
+  NeighbourList neighbours_;  // the rows, their per-ball lists, when to rebuild (engine/neighbour_list.hpp)
   // The force sum, in one order for any thread count (so any thread count gives the same bits): a
   // ball's ball-ball rows in descending row order, then its wall rows in row order. The pair loop
   // runs over the balls a of a thread's range from its last ball down, through a's ball-ball rows
-  // (rows first_rows_[a]..[a+1]: keys are sorted by kind, then a, then b > a) from the last down,
+  // (NeighbourList::first_rows: keys are sorted by kind, then a, then b > a) from the last down,
   // and adds each row's share to a and to b: b's own rows came before (b > a), and every row (x, b)
   // with x < a comes after. A row whose b lies beyond the thread's range leaves b's share in
   // crossing_, added in descending row order once the thread's own rows are done (by b's thread):
-  // those rows (x below the range of b's thread) come last in b's
-  // order. Then the wall rows, from F_c and share_moment_.
-  std::vector<std::uint32_t> first_rows_;
-  // Per ball, the ball-ball rows where it is piece 2 (in row order; the same sums from the rows
-  // when the pass's sums are not at hand, ball_stiffness), and its wall rows in wall_rows_.
-  std::vector<std::uint32_t> late_rows_start_;
-  std::vector<std::uint32_t> late_rows_;
-  std::vector<std::uint32_t> wall_rows_start_;
+  // those rows (x below the range of b's thread) come last in b's order. Then the wall rows, from
+  // F_c and share_moment_.
   std::vector<Vec3> share_moment_;           // [N m] moment of wall row r on its ball
   std::vector<std::vector<CrossShare>> crossing_;  // per thread of the last force pass
   // Per range of the split, its lowest ball with a ball-ball row into a later range: below it the
   // range's thread adds no crossing share (force_pass). Made once per split and row lists.
   std::vector<std::size_t> crossing_floor_;
-  std::size_t row_span_ = 0;  // the largest b − a of a ball-ball row (build_row_lists)
   static constexpr std::size_t kFloorUnknown = ~std::size_t{0};
   // Per ball, Σ(k̂_n + k̂_s) [N/m] and Σ k̂_s |x_c − x|² [N m] of the last force pass (in the order of
   // the forces), valid while stiffness_ready_.
@@ -333,13 +321,6 @@ class Simulation {
   const motion::ContactSums* contact_sums() const {
     return sums_current_ && ball_sums_.size() == balls.size() ? ball_sums_.data() : nullptr;
   }
-  // A bound on the largest travel of a ball since the neighbour list was made [m]: exact after
-  // rebuild_if_needed's pass over the positions (0 at a rebuild), then grown by each record motion
-  // by the step's largest |V| Δt (motion_travel_known_: for this step's rebuild_if_needed). The
-  // record motion so reads no reference position; the exact pass runs only when the bound reaches
-  // half the skin, and a bound within it gives the exact check's answer: the same rebuilds.
-  bool motion_travel_known_ = false;
-  double travel_bound_ = 0.0;
   // Within one cycle() call nothing but a controller changes the applied loads or the radii, and a
   // controller drops the records: what the record motion knows of them holds until drop_records().
   // applied_zero_: every applied force and moment is +0.0 (motion::step_ball<false>).
