@@ -80,7 +80,7 @@ double Simulation::next_timestep() const {
 
 double Simulation::skin() const {
   if (settings.skin > 0.0) return settings.skin;
-  if (skin_known_) return skin_;  // (a serial sum over the radii: ≈ 1 % of a step at 100,800 spheres)
+  if (skin_known_) return skin_;  // (a serial sum over the radii: kept while the radii cannot change)
   if (balls.size() == 0) return 0.0;
   const double sum = std::accumulate(balls.radius.begin(), balls.radius.end(), 0.0);
   return 0.1 * 2.0 * sum / static_cast<double>(balls.size());
@@ -250,12 +250,11 @@ void Simulation::refresh_mappings() {
 
 void Simulation::advance_records(double dt, const double* inertial_mass, const double* inertial_inertia,
                                  bool write_columns) {
-  // One pass over the balls where there were three (the law of motion on the columns, the travel
-  // check, the force pass's copy into the records), ≈ 660 bytes streamed a ball a step against ≈ 420
-  // here: 1.04 x at 100,800 spheres (docs/performance.md, fifteenth session). The law is
-  // advance_balls's (motion::step_ball). The travel since the live rows is measured ball by ball (the
-  // check's expression); that since the neighbour list only bounded (NeighbourList::travel_bound, no reference
-  // position read), exactly by rebuild_if_needed when the bound reaches half the skin.
+  // The law of motion, the travel check and the records the force pass reads, in one pass over the
+  // balls (≈ 420 bytes streamed a ball a step; ≈ 660 in three passes). The law is advance_balls's
+  // (motion::step_ball). The travel since the live rows is measured ball by ball (the check's
+  // expression); that since the neighbour list only bounded (NeighbourList::travel_bound, no
+  // reference position read), exactly by rebuild_if_needed when the bound reaches half the skin.
   using namespace motion;
   const std::size_t n = balls.size();
   const double alpha = settings.local_damping;
@@ -622,7 +621,7 @@ HILLDEM_INLINE void Simulation::store_kept_lane(std::size_t c, const ContactBatc
                                                bool want_stiffness, bool reported, bool history) {
   // The columns of store_row for a contact that stays (written in the same cases), straight from the
   // lanes: no RowOutcome and RowShare copied, no moments computed one lane at a time, no keys read
-  // again (docs/performance.md).
+  // again.
   using F = ContactBatch;
   if (history) {
     contacts.shear_state[c] = batch.get3(F::kShx, lane);
@@ -673,12 +672,10 @@ void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
   // Each lane's inputs: from the records of its two balls x2 − x1 (x2 with its periodic image), the
   // radii, velocities and spins, and for the hill law the sums of the two balls' terms; from its row
   // the last normal and shear force and the parameters. The ball values copied lane by lane are 28
-  // loads and 28 stores a lane, and this core stores about one value a cycle to different lines
-  // (≈ 1.3 cycles a field, docs/performance.md, twelfth session); with AVX-512 the records of eight
-  // lanes are loaded whole and transposed in registers, and each field is stored once for the eight
-  // lanes (1.05 x at 100,800 spheres). The arithmetic is the same (x2 − x1 and the sums, lane by
-  // lane), so the bits are those of the lane-by-lane copy. (AVX-512 gathers were slower than the
-  // copy here.)
+  // loads and 28 stores a lane, and a core stores about one value a cycle to different lines; with
+  // AVX-512 the records of eight lanes are loaded whole and transposed in registers, and each field
+  // is stored once for the eight lanes (docs/performance.md). The arithmetic is the same (x2 − x1 and
+  // the sums, lane by lane), so the bits are those of the lane-by-lane copy.
   using F = ContactBatch;
   const BallKin* kin = ball_kin_.data();
   const std::size_t n = batch.size();
@@ -756,11 +753,8 @@ void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
       batch.col(F::kCs)[lane] = ka.terms.shear + kb.terms.shear;
     }
   }
-  // The rows' own inputs. (From the row columns, eight rows' Vec3s loaded whole and transposed, and
-  // the parameters set for eight lanes at once, gave 1.000 x in cache, 16 pairs: not kept. From the
-  // live records, one aligned line a row, it pays: below.)
-  // A hill lane's history, parameter set and M: from its live record, or from
-  // the row columns.
+  // The rows' own inputs. A hill lane's history, parameter set and M: from its live record (eight
+  // lanes at a time with AVX-512: one aligned line a row), or from the row columns.
   auto put_hill = [&](std::size_t lane, const Vec3& normal, const Vec3& shear, std::uint32_t set, Moisture m) {
     batch.put3(F::kNox, lane, normal);
     batch.put3(F::kSx, lane, shear);
@@ -834,21 +828,15 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
   const BallKin* kin = ball_kin_.data();
   const ContactKey* keys = contacts.key.data();
   // Each ball's force and moment sums in one line, each a vector with a +0.0 fourth lane
-  // (motion::ContactSums): a row's share into a ball is one vector operation per sum where it was
-  // three scalar ones. The same additions component by component, so the same bits (≈ 1.04-1.06 x
-  // against two Vec3 columns, binaries in turn at 100,800 spheres; docs/performance.md, sixteenth
-  // session).
+  // (motion::ContactSums): a row's share into a ball is one vector operation per sum, not three
+  // scalar ones. The same additions component by component, so the same bits.
   motion::ContactSums* __restrict sums = ball_sums_.data();
   // Prefetch distances in rows (the pass runs down the rows; below). The row columns run downwards,
-  // and the hardware prefetcher follows descending streams poorly: perf put a fifth of the pair
-  // loop on the first loads of the history, parameter and flag columns. Asking for the history and
-  // parameters 32 rows ahead gave 1.11 x at 100,800 spheres (4 pairs; 8, 16 and 32 rows the same);
-  // the byte columns and the keys 128 rows ahead 1.07-1.09 x more there, but 0.97 x at 11,200 (the
-  // rows in the outer caches), hence only for more than 2^17 rows. (Asking for the flags every 16th
-  // row instead of every row, with no threshold, was 0.91 x at 100,800.) Below 2^17 rows nothing is
-  // asked for ahead at all: the prefetches' own work (≈ 30 instructions a row) cost more than they
-  // hid there: without them 1.031 x at 11,200 spheres (6 pairs; ≈ 50,000 rows), 1.059 x in cache
-  // (3,576 spheres, 6 pairs) and 1.015 x on a lab test (4 pairs) (tenth session).
+  // and the hardware prefetcher follows descending streams poorly, so the pair loop would wait on
+  // the first loads of the history, parameter and flag columns: the history and parameters are asked
+  // for 32 rows ahead, the byte columns and the keys 128 rows ahead. Only for more than 2^17 rows:
+  // below, the rows sit in the outer caches, and the prefetches' own work (≈ 30 instructions a row)
+  // costs more than they hide (the distances and the threshold: docs/performance.md).
   constexpr std::size_t kPrefetchRows = 16;
   constexpr std::size_t kPrefetchColumns = 32;
   constexpr std::size_t kPrefetchFlags = 128;
@@ -979,8 +967,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
     const BallKin& ka = kin[a];
     if (far && a >= kPrefetchBalls) {
       // The record, force sums and row range of the ball some places down: the pass meets each ball
-      // first as the `a` of its rows, a descending stream (1.01-1.06 x at 100,800 spheres, three
-      // runs of the in-process alternation of `hilldem bench --alternate`, thirteenth session).
+      // first as the `a` of its rows, a descending stream.
       const std::size_t ahead = a - kPrefetchBalls;
       const char* record = reinterpret_cast<const char*>(kin + ahead);
       __builtin_prefetch(record);
@@ -1001,8 +988,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
         if (far) {  // (nothing asked for ahead when the rows fit in the caches: see above)
           if (k >= kPrefetchRows) {
             // The ball record of a neighbour some rows on, and its force sums: the neighbours in the layer
-            // above a ball are a whole layer away in memory, and the hardware prefetcher misses them
-            // (perf annotate).
+            // above a ball are a whole layer away in memory, and the hardware prefetcher misses them.
             const std::size_t ahead_ball = keys[row_at(k - kPrefetchRows)].b;
             const char* ahead = reinterpret_cast<const char*>(kin + ahead_ball);
             __builtin_prefetch(ahead);
@@ -1074,10 +1060,9 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
       const std::uint32_t* live_first = live_.first();
       for (std::size_t k = live_first[a + 1]; k-- > live_first[a];) {
         if (far) {
-          // The neighbour's record and sums, as in run_rows (24 rows ahead the same as 16), and the
-          // record 64 rows on (one line a row; 32-128 rows alike, 16 slower). Asked for to be read,
-          // not written (prefetchw), although both lines are written later: 1.02-1.03 x each for the
-          // records and for the sums, in one run (eighteenth session).
+          // The neighbour's record and sums, as in run_rows, and the record 64 rows on (one line a
+          // row). Asked for to be read, not written (prefetchw), although both lines are written
+          // later (docs/performance.md).
           if (k >= kPrefetchRows) {
             const std::size_t ahead_ball = rec[k - kPrefetchRows].b;
             const char* ahead = reinterpret_cast<const char*>(kin + ahead_ball);
@@ -1087,8 +1072,8 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
           }
           if (k >= kPrefetchRecords) __builtin_prefetch(rec + k - kPrefetchRecords);
         } else if (k >= kPrefetchRecords) {
-          // The records alone in the caches' range too: the stream runs down, and the loads of its
-          // lines drew samples there (1.008-1.023 x at 11,200 spheres, four runs; nineteenth session).
+          // The records alone in the caches' range too: the stream runs down, and the hardware
+          // prefetcher follows it poorly.
           __builtin_prefetch(rec + k - kPrefetchRecords);
         }
         const LiveRecord& r = rec[k];
@@ -1123,8 +1108,8 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
 
 void Simulation::wall_block(std::size_t k0, std::size_t k1, double dt, BlockScratch& scratch, std::size_t& bad_row,
                             std::int64_t& batched_count) {
-  // Wall rows row by row took 12 % of a lab test (perf, C5b hill test): the chain of square roots
-  // and divisions of one contact at a time, as ball-ball rows before the batches.
+  // Existing linear wall contacts through a linear batch: one contact's law at a time is a chain of
+  // dependent square roots and divisions (engine/contact_batch.hpp).
   const bool want_stiffness = settings.auto_timestep || settings.density_scaling;
   const bool batched = !settings.track_shear_displacement;
   using F = ContactBatch;
@@ -1243,10 +1228,9 @@ void Simulation::force_pass(double dt) {
   if (!terms_ready || !live_.made_for(rows, settings.proximity)) live_.invalidate();
   if (live_.visited() && !live_.current()) refresh_live_rows();
   live_.end_pass_measure();
-  // The live rows through their records on the steps nobody looks at, made when
-  // at least kRecordSteps more steps follow in this cycle() call: making them and writing them back
-  // cost about half a step at 100,800 spheres (calls of 9 steps gave 1.021 x against 1.084 x for calls
-  // of 200), which ≈ 1.08 x a step wins back in about eight steps.
+  // The live rows through their records on the steps nobody looks at, made when at least
+  // kRecordSteps more steps follow in this cycle() call: making them and writing them back costs
+  // about half a step, which the faster steps win back in about eight (docs/performance.md).
   constexpr std::int64_t kRecordSteps = 8;
   const bool records = live_.visited() && !write_results_;
   if (live_.records_ready() && !records) live_.sync_records(contacts);
@@ -1257,9 +1241,8 @@ void Simulation::force_pass(double dt) {
   std::atomic<bool> late_share{false};
 #pragma omp parallel reduction(min : bad_row) reduction(+ : batched) if (n > kParallelMin)
   {
-    // ≈ 60 kB: on the heap, not the thread's stack. Default-initialised: make_unique would zero it on
-    // every pass (≈ 1 % of the in-cache bed's instructions, callgrind; 1.023 x there without, 6 pairs),
-    // and every lane value a law or the scatter uses is written before it is read.
+    // ≈ 60 kB: on the heap, not the thread's stack. Default-initialised (make_unique would zero it on
+    // every pass): every lane value a law or the scatter uses is written before it is read.
     std::unique_ptr<BlockScratch> scratch(new BlockScratch);
 #pragma omp single
     {

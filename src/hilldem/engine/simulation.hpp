@@ -200,8 +200,7 @@ class Simulation {
     double k_tran = 0.0, k_shear = 0.0, gap = 0.0;
     bool ok = true;  // false on a non-finite force
     // Zero the forces and moments, and the stiffness terms when they are read, field by field:
-    // `force = moment = Vec3{}` reloads the moment just stored and stalls store forwarding (40 % of
-    // the pair loop's samples in cache; 1.05 × in cache).
+    // `force = moment = Vec3{}` reloads the moment just stored and stalls store forwarding.
     void clear(bool stiffness) {
       force = Vec3{};
       moment = Vec3{};
@@ -331,8 +330,8 @@ class Simulation {
   bool body_terms_ready_ = false;            // ball_kin_[i].terms are up to date (see force_pass)
   // The hill parameters the batched pass reads, by set: row c's are hill_sets_[row_hill_set_[c]], the
   // distinct parameters of the rows and the rules (a few: the rules', and what make_wet and stages
-  // gave). A 4-byte index per row instead of the 24-byte parameters: 1.04 x at 100,800 spheres with
-  // none read at all. Made from contacts.hill_params (which stays the record) whenever the mappings
+  // gave): a 4-byte index per row instead of the 24-byte parameters, for the pair loop's memory
+  // traffic. Made from contacts.hill_params (which stays the record) whenever the mappings
   // are (refresh_param_sets: at a rebuild, refresh_mappings(), a restore); create_contact() sets its
   // row's, and flags the sets stale if its rule's parameters are not the set made for the rule.
   std::vector<HillParams> hill_sets_;
