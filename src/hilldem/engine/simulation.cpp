@@ -124,12 +124,12 @@ void Simulation::step_body(bool last) {
     i_scaled = scaled_inertia_.data();
   }
   // §1.2 steps 1-2
-  if (records_current_ && ball_kin_.size() == balls.size()) {
+  if (ball_kin_.current() && ball_kin_.size() == balls.size()) {
     advance_records(dt, m_scaled, i_scaled, watched);
   } else {
     drop_records();
     advance_balls(balls, MotionSettings{settings.gravity, settings.local_damping}, dt, m_scaled, i_scaled,
-                  contact_sums());
+                  ball_kin_.contact_sums(balls.size()));
   }
   for (Wall& w : walls.walls) {
     // Bound on how far any point of the wall moved (for the neighbour-list check).
@@ -153,7 +153,7 @@ void Simulation::step_body(bool last) {
 ContactGeometry Simulation::geometry(std::size_t c) const {
   const ContactKey& k = contacts.key[c];
   // (Between steps the columns hold the positions; within an unwatched step the records.)
-  auto position = [&](std::size_t i) -> const Vec3& { return columns_stale_ ? ball_kin_[i].position : balls.position[i]; };
+  auto position = [&](std::size_t i) -> const Vec3& { return ball_kin_.columns_stale() ? ball_kin_[i].position : balls.position[i]; };
   const Vec3& x1 = position(k.a);
   const double r1 = balls.radius[k.a];
   ContactGeometry g;
@@ -250,111 +250,28 @@ void Simulation::refresh_mappings() {
 
 void Simulation::advance_records(double dt, const double* inertial_mass, const double* inertial_inertia,
                                  bool write_columns) {
-  // The law of motion, the travel check and the records the force pass reads, in one pass over the
-  // balls (≈ 420 bytes streamed a ball a step; ≈ 660 in three passes). The law is advance_balls's
-  // (motion::step_ball). The travel since the live rows is measured ball by ball (the check's
-  // expression); that since the neighbour list only bounded (NeighbourList::travel_bound, no
-  // reference position read), exactly by rebuild_if_needed when the bound reaches half the skin.
-  using namespace motion;
+  // The travel since the live rows is measured ball by ball (the check's expression), or bounded
+  // without it while the bound, grown by four steps like the last, stays within the slack; that
+  // since the neighbour list only bounded (NeighbourList::travel_bound, no reference position read),
+  // exactly by rebuild_if_needed when the bound reaches half the skin.
   const std::size_t n = balls.size();
-  const double alpha = settings.local_damping;
-  const V4 gravity = load(settings.gravity);
   const bool live_list = live_.has_positions(n);
-  const Vec3* at_live = live_.positions();
-  // The travel since the live rows ball by ball (reading each ball's position then), or bounded
-  // without it while the bound, grown by four steps like the last, stays within the slack.
   const bool bounded = live_list && live_.bound_holds();
   const bool live = live_list && !bounded;
-  if (!applied_known_) {  // (once per cycle() call: nothing changes them until then)
-    const auto zero = [](const std::vector<Vec3>& v) {
-      const Vec3 z{};
-      return std::all_of(v.begin(), v.end(), [&z](const Vec3& x) { return std::memcmp(&x, &z, sizeof z) == 0; });
-    };
-    applied_zero_ = zero(balls.applied_force) && zero(balls.applied_moment);
-    applied_known_ = true;
-  }
-  BallKin* kin = ball_kin_.data();
-  const motion::ContactSums* sums = contact_sums();
-  // [m²/s²], [m²], [m²] (a NaN wins: see rebuild_if_needed)
-  double max_v2 = 0.0, max_x2 = 0.0, worst_live = 0.0;
-  // Each thread's balls: in proportion to the threads' shares of the force pass (WorkSplit: equal,
-  // given or by their measured speeds), so that a thread on a slower core is not the one every other
-  // waits for. Which thread moves a ball changes no result.
-  const std::vector<double>& shares = split_.shares();  // (not changed during the pass)
-  auto pass = [&](auto applied) {
-#pragma omp parallel if (n > kParallelMin)
-    {
-      double mine_v2 = 0.0, mine_x2 = 0.0, mine_live = 0.0;
-      const auto threads = static_cast<std::size_t>(omp_get_num_threads());
-      const auto t = static_cast<std::size_t>(omp_get_thread_num());
-      std::size_t i0 = n * t / threads, i1 = n * (t + 1) / threads;
-      if (shares.size() == threads) {
-        double before = 0.0;
-        for (std::size_t s = 0; s < t; ++s) before += shares[s];
-        const auto at = [n](double f) { return static_cast<std::size_t>(static_cast<double>(n) * std::clamp(f, 0.0, 1.0)); };
-        i0 = t == 0 ? 0 : at(before);
-        i1 = t + 1 == threads ? n : at(before + shares[t]);
-      }
-      for (std::size_t i = i0; i < i1; ++i) {
-        BallKin& k = kin[i];
-        V4 x = load(k.position), v = load(k.velocity), w = load(k.spin);
-        const V4 cf = sums ? sums[i].force : load(balls.contact_force[i]);
-        const V4 cm = sums ? sums[i].moment : load(balls.contact_moment[i]);
-        step_ball<decltype(applied)::value>(balls, i, gravity, alpha, dt, k.mass, k.inertia, inertial_mass,
-                                            inertial_inertia, cf, cm, x, v, w);
-        store(k.velocity, v);
-        store(k.spin, w);
-        store(k.position, x);
-        if (write_columns) {
-          store(balls.velocity[i], v);
-          store(balls.spin[i], w);
-          store(balls.position[i], x);
-        }
-        const double v2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-        const double x2 = x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
-        if (!(v2 <= mine_v2)) mine_v2 = v2;
-        if (!(x2 <= mine_x2)) mine_x2 = x2;
-        if (live) {
-          const double l2 = norm2(k.position - at_live[i]);
-          if (!(l2 <= mine_live)) mine_live = l2;
-        }
-      }
-#pragma omp critical(hilldem_record_motion)
-      {
-        if (!(mine_v2 <= max_v2)) max_v2 = mine_v2;
-        if (!(mine_x2 <= max_x2)) max_x2 = mine_x2;
-        if (!(mine_live <= worst_live)) worst_live = mine_live;
-      }
-    }
-  };
-  // Without the applied loads' 48 bytes a ball when all are zero.
-  if (applied_zero_) pass(std::false_type{});
-  else pass(std::true_type{});
-  columns_stale_ = !write_columns;
+  const BallRecords::Motion moved =
+      ball_kin_.advance(balls, settings.gravity, settings.local_damping, dt, inertial_mass, inertial_inertia,
+                        write_columns, split_.shares(), live, live_.positions());
   // No ball moved farther than |V|max Δt this step, but for the rounding of x + V Δt (below
   // 2.3e-16 |x| a step) and of |V|: a margin of 1e-9 of the first and 1e-15 |x|max [m]. A NaN stays.
-  const double growth = std::sqrt(max_v2) * dt * (1.0 + 1e-9) + 1e-15 * std::sqrt(max_x2);
+  const double growth = std::sqrt(moved.max_v2) * dt * (1.0 + 1e-9) + 1e-15 * std::sqrt(moved.max_x2);
   neighbours_.grow_travel_bound(growth);
-  live_.after_motion(live_list, live, bounded, worst_live, growth);
-}
-
-void Simulation::sync_ball_columns() {
-  sync_sum_columns();
-  if (!columns_stale_) return;
-  const std::size_t n = std::min(balls.size(), ball_kin_.size());  // (the same, while the columns lag)
-#pragma omp parallel for schedule(static) if (n > kParallelMin)
-  for (std::size_t i = 0; i < n; ++i) {
-    balls.position[i] = ball_kin_[i].position;
-    balls.velocity[i] = ball_kin_[i].velocity;
-    balls.spin[i] = ball_kin_[i].spin;
-  }
-  columns_stale_ = false;
+  live_.after_motion(live_list, live, bounded, moved.worst_live, growth);
 }
 
 void Simulation::rebuild_if_needed() {
   const bool measured = neighbours_.take_motion_bound();  // by advance_records, this step
   if (!neighbours_.stale(balls.size())) {
-    if (records_current_ && !skin_known_) {  // (the radii stay until the records are dropped)
+    if (ball_kin_.current() && !skin_known_) {  // (the radii stay until the records are dropped)
       skin_ = skin();
       skin_known_ = true;
     }
@@ -368,7 +285,7 @@ void Simulation::rebuild_if_needed() {
     // rebuild, which ends the run (NeighbourList::rebuild). And the largest since the live rows were
     // made, while they are. (The positions from the records when the columns lag behind them.)
     const std::size_t n = balls.size();
-    const bool from_records = columns_stale_;
+    const bool from_records = ball_kin_.columns_stale();
     const bool live = live_.has_positions(n);
     const Vec3* at_live = live_.positions();
     const Vec3* at_build = neighbours_.position_at_build().data();
@@ -440,8 +357,7 @@ void Simulation::restore_cycle_state(CycleState s) {
   for (std::size_t c = 1; c < contacts.size(); ++c)
     if (!(contacts.key[c - 1] < contacts.key[c])) throw RunError("cycle state: contact rows are not sorted by key");
   forces_ready_ = s.forces_ready;
-  sums_current_ = false;  // the restored columns hold the sums the next step moves with
-  sum_columns_stale_ = false;
+  ball_kin_.forget_sums();  // the restored columns hold the sums the next step moves with
   const bool rebuild_needed = s.rebuild_needed || s.position_at_build.empty();  // (before the move below)
   neighbours_.restore(rebuild_needed, s.rebuilds, static_cast<std::size_t>(s.unassigned_pairs),
                       std::move(s.position_at_build), s.wall_travel);
@@ -830,7 +746,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
   // Each ball's force and moment sums in one line, each a vector with a +0.0 fourth lane
   // (motion::ContactSums): a row's share into a ball is one vector operation per sum, not three
   // scalar ones. The same additions component by component, so the same bits.
-  motion::ContactSums* __restrict sums = ball_sums_.data();
+  motion::ContactSums* __restrict sums = ball_kin_.sums();
   // Prefetch distances in rows (the pass runs down the rows; below). The row columns run downwards,
   // and the hardware prefetcher follows descending streams poorly, so the pair loop would wait on
   // the first loads of the history, parameter and flag columns: the history and parameters are asked
@@ -1186,40 +1102,20 @@ void Simulation::force_pass(double dt) {
   // descending row order, then its wall rows (NeighbourList::first_rows, force_block, collect_forces). So results
   // depend neither on the blocks (ContactBatch::pad_lanes) nor on the thread count. The first
   // failing row is found by a min-reduction, so the outcome does not depend on the thread count.
-  if (ball_sums_.size() != n) ball_sums_.resize(n);
-  sums_current_ = false;  // (until collect_forces has added every share)
+  ball_kin_.begin_sums(n);  // (not current until collect_forces has added every share)
   const std::size_t block = std::max<std::size_t>(1, balls_per_block);
   std::size_t bad_row = rows;
   std::int64_t batched = 0;
   const bool terms_ready = body_terms_ready_ && ball_kin_.size() == n;
   if (!terms_ready || hill_sets_stale_ || row_hill_set_.size() != rows) refresh_param_sets();
   if (ball_kin_.size() != n) drop_records();
-  ball_kin_.resize(n);
-  // What the pair loop reads of each ball, in one record (two cache lines): one memory stream per
-  // neighbourhood instead of one per column. The position, velocity and spin from the columns unless
-  // the records hold them already (advance_records, or an earlier pass in this step); the hill terms
-  // (four divisions per ball) only when the properties may have changed: at a rebuild,
-  // refresh_mappings() or a restore, the moments at which the row-by-row path's mappings are computed
-  // too (real masses, §2.4). (Within a cycle() call nothing changes a radius, but a controller,
-  // and a controller drops the records.)
-  if (!records_current_ || !terms_ready) {
-    const bool copy = !records_current_;
-#pragma omp parallel for schedule(static) if (n > kParallelMin)
-    for (std::size_t i = 0; i < n; ++i) {
-      BallKin& k = ball_kin_[i];
-      if (copy) {
-        k.position = balls.position[i];
-        k.velocity = balls.velocity[i];
-        k.spin = balls.spin[i];
-        k.mass = balls.mass[i];
-        k.inertia = balls.inertia[i];
-      }
-      k.radius = balls.radius[i];
-      if (!terms_ready)
-        k.terms = hill_body_terms(balls.radius[i], balls.young_mod[i], balls.pois_ratio[i], balls.mass[i]);
-    }
-    records_current_ = true;
-  }
+  // What the pair loop reads of each ball, in one record (two cache lines): the position, velocity
+  // and spin from the columns unless the records hold them already (advance_records, or an earlier
+  // pass in this step); the hill terms (four divisions per ball) only when the properties may have
+  // changed: at a rebuild, refresh_mappings() or a restore, the moments at which the row-by-row
+  // path's mappings are computed too (real masses, §2.4). (Within a cycle() call nothing but a
+  // controller changes a radius, and a controller drops the records.)
+  if (!ball_kin_.current() || !terms_ready) ball_kin_.fill(balls, !ball_kin_.current(), !terms_ready);
   // The live rows, made again when a ball may have moved more than the slack since they were
   // (rebuild_if_needed measured it), or the rows, their models or the proximity may have changed. (A
   // contact made since, in any pass, was a live row: the others were too far apart to touch.) Not
@@ -1330,7 +1226,7 @@ void Simulation::force_pass(double dt) {
 
 void Simulation::add_crossing(const std::vector<CrossShare>& list, std::size_t first, std::size_t last) {
   const bool want_stiffness = settings.auto_timestep || settings.density_scaling;
-  motion::ContactSums* __restrict sums = ball_sums_.data();
+  motion::ContactSums* __restrict sums = ball_kin_.sums();
   for (const CrossShare& s : list)
     if (s.b >= first && s.b < last) {
       sums[s.b].force += motion::load(s.force);
@@ -1342,7 +1238,7 @@ void Simulation::add_crossing(const std::vector<CrossShare>& list, std::size_t f
 
 void Simulation::add_wall_rows(std::size_t k0, std::size_t k1) {
   const bool want_stiffness = settings.auto_timestep || settings.density_scaling;
-  motion::ContactSums* __restrict sums = ball_sums_.data();
+  motion::ContactSums* __restrict sums = ball_kin_.sums();
   for (std::size_t k = k0; k < k1; ++k) {
     const std::uint32_t c = neighbours_.wall_rows()[k];
     const std::size_t a = contacts.key[c].a;
@@ -1375,21 +1271,9 @@ void Simulation::collect_forces() {
   }
   stiffness_ready_ = want_stiffness;
   // The BallStore's columns of the sums on the passes someone may read them after (as the reported
-  // contact columns); the law of motion reads ball_sums_ itself.
-  sums_current_ = true;
-  sum_columns_stale_ = true;
-  if (write_results_) sync_sum_columns();
-}
-
-void Simulation::sync_sum_columns() {
-  if (!sum_columns_stale_) return;
-  const std::size_t n = std::min(balls.size(), ball_sums_.size());
-#pragma omp parallel for schedule(static) if (n > kParallelMin)
-  for (std::size_t i = 0; i < n; ++i) {
-    motion::store(balls.contact_force[i], ball_sums_[i].force);
-    motion::store(balls.contact_moment[i], ball_sums_[i].moment);
-  }
-  sum_columns_stale_ = false;
+  // contact columns); the law of motion reads the sums themselves.
+  ball_kin_.end_sums();
+  if (write_results_) ball_kin_.sync_sum_columns(balls);
 }
 
 void Simulation::add_row_stiffness(std::size_t c, double radius, double& k_tran, double& k_rot) const {

@@ -19,7 +19,7 @@
 #include "hilldem/bodies/ball_store.hpp"
 #include "hilldem/bodies/wall_store.hpp"
 #include "hilldem/contact/contact_store.hpp"
-#include "hilldem/engine/ball_kin.hpp"
+#include "hilldem/engine/ball_records.hpp"
 #include "hilldem/engine/contact_batch.hpp"
 #include "hilldem/engine/live_rows.hpp"
 #include "hilldem/engine/neighbour_list.hpp"
@@ -148,7 +148,7 @@ class Simulation {
   // bodies by hand.
   void invalidate_forces() {
     forces_ready_ = false;
-    sums_current_ = false;
+    ball_kin_.invalidate_sums();
     body_terms_ready_ = false;
     neighbours_.invalidate();
   }
@@ -180,14 +180,12 @@ class Simulation {
   // neighbour list (and since the live rows) measured as it moves; write_columns: the BallStore's
   // columns too.
   void advance_records(double dt, const double* inertial_mass, const double* inertial_inertia, bool write_columns);
-  // The columns from the records, if the records are ahead of them (columns_stale_).
-  void sync_ball_columns();
+  // The columns from the records, if the records are ahead of them.
+  void sync_ball_columns() { ball_kin_.sync_columns(balls); }
   // From now on the columns hold the balls' state (synced first): before anything that may read or
   // write them (a controller, a rebuild, the start of a cycle() call).
   void drop_records() {
-    sync_ball_columns();
-    records_current_ = false;
-    applied_known_ = false;
+    ball_kin_.drop(balls);
     skin_known_ = false;
   }
   // What a row gives its two bodies (zero when the row is not an active contact).
@@ -302,28 +300,11 @@ class Simulation {
   // the forces), valid while stiffness_ready_.
   std::vector<double> ball_k_tran_, ball_k_rot_;
   bool stiffness_ready_ = false;
-  std::vector<BallKin> ball_kin_;             // per ball, what the batched pair loop reads
-  // The records' position, velocity and spin are the balls' state: from the force pass's copy on,
-  // and through the record motion of the steps that follow within one cycle() call. The columns
-  // lag behind while columns_stale_ (only while records_current_).
-  bool records_current_ = false;
-  bool columns_stale_ = false;
-  // Each ball's contact force and moment sums [N], [N m], as the force pass adds them up (one line a
-  // ball, motion::ContactSums). The law of motion reads them while sums_current_ (from the end of a
-  // force pass until a restore or invalidate_forces(); a restored run moves with the columns it
-  // restored). The BallStore's contact_force and contact_moment columns are written from them on
-  // watched passes, and lag behind while sum_columns_stale_ (sync_sum_columns, sync_ball_columns).
-  std::vector<motion::ContactSums> ball_sums_;
-  bool sums_current_ = false;
-  bool sum_columns_stale_ = false;
-  void sync_sum_columns();
-  const motion::ContactSums* contact_sums() const {
-    return sums_current_ && ball_sums_.size() == balls.size() ? ball_sums_.data() : nullptr;
-  }
-  // Within one cycle() call nothing but a controller changes the applied loads or the radii, and a
-  // controller drops the records: what the record motion knows of them holds until drop_records().
-  // applied_zero_: every applied force and moment is +0.0 (motion::step_ball<false>).
-  bool applied_known_ = false, applied_zero_ = false;
+  // Per ball, what the pair loop reads (BallKin), the law of motion on it, and the force sums
+  // (engine/ball_records.hpp).
+  BallRecords ball_kin_;
+  // Within one cycle() call nothing but a controller changes the radii, and a controller drops the
+  // records: skin_ holds until drop_records().
   bool skin_known_ = false;
   double skin_ = 0.0;  // [m] skin() while skin_known_
   WorkSplit split_;  // the threads' ranges of balls in the force pass
