@@ -584,7 +584,7 @@ using lanes::transpose8;
 using lanes::widen8;
 #endif
 
-void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
+HILLDEM_INLINE void Simulation::fill_ball_lanes(ContactBatch& batch, bool hill) const {
   // Each lane's inputs: from the records of its two balls x2 − x1 (x2 with its periodic image), the
   // radii, velocities and spins, and for the hill law the sums of the two balls' terms; from its row
   // the last normal and shear force and the parameters. The ball values copied lane by lane are 28
@@ -669,6 +669,11 @@ void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
       batch.col(F::kCs)[lane] = ka.terms.shear + kb.terms.shear;
     }
   }
+}
+
+HILLDEM_INLINE void Simulation::fill_row_lanes(ContactBatch& batch, bool hill) const {
+  using F = ContactBatch;
+  const std::size_t n = batch.size();
   // The rows' own inputs. A hill lane's history, parameter set and M: from its live record (eight
   // lanes at a time with AVX-512: one aligned line a row), or from the row columns.
   auto put_hill = [&](std::size_t lane, const Vec3& normal, const Vec3& shear, std::uint32_t set, Moisture m) {
@@ -679,7 +684,7 @@ void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
     batch.col(F::kDamp)[lane] = p.damp_con;
     batch.col(F::kWet)[lane] = m == Moisture::Wet ? 1.0 : 0.0;
   };
-  lane = 0;
+  std::size_t lane = 0;
 #if defined(__AVX512F__)
   if (hill) {
     // Eight lanes with live records at a time: the records loaded whole and transposed in registers
@@ -728,6 +733,11 @@ void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
       batch.col(F::kFric)[lane] = contacts.linear_params[c].fric;
     }
   }
+}
+
+void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
+  fill_ball_lanes(batch, hill);
+  fill_row_lanes(batch, hill);
 }
 
 void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_end, double dt, BlockScratch& scratch,
@@ -1096,16 +1106,51 @@ void Simulation::force_pass(double dt) {
   const std::size_t rows = contacts.size();
   const std::size_t n = balls.size();
   // Blocks of balls, each with its own rows (ball-ball rows are sorted by their first ball); each
-  // row writes only its own columns. Each thread takes a range of balls of equal work
-  // (WorkSplit) in blocks of balls_per_block from its start, and runs the blocks from the last
-  // down. Every ball's force is summed in one order whatever the ranges: its ball-ball rows in
-  // descending row order, then its wall rows (NeighbourList::first_rows, force_block, collect_forces). So results
-  // depend neither on the blocks (ContactBatch::pad_lanes) nor on the thread count. The first
-  // failing row is found by a min-reduction, so the outcome does not depend on the thread count.
+  // row writes only its own columns. Each thread takes a range of balls of equal work (WorkSplit)
+  // in blocks of balls_per_block from its start, and runs the blocks from the last down
+  // (run_range). Every ball's force is summed in one order whatever the ranges: its ball-ball rows
+  // in descending row order, then its wall rows (NeighbourList::first_rows, force_block,
+  // collect_forces). So results depend neither on the blocks (ContactBatch::pad_lanes) nor on the
+  // thread count. The first failing row is found by a min-reduction, so the outcome does not depend
+  // on the thread count.
   ball_kin_.begin_sums(n);  // (not current until collect_forces has added every share)
-  const std::size_t block = std::max<std::size_t>(1, balls_per_block);
   std::size_t bad_row = rows;
   std::int64_t batched = 0;
+  prepare_pass();
+  std::unique_ptr<std::atomic<bool>[]> crossing_done;  // per thread: its crossing list is final
+  std::atomic<bool> late_share{false};
+#pragma omp parallel reduction(min : bad_row) reduction(+ : batched) if (n > kParallelMin)
+  {
+    // ≈ 60 kB: on the heap, not the thread's stack. Default-initialised (make_unique would zero it on
+    // every pass): every lane value a law or the scatter uses is written before it is read.
+    std::unique_ptr<BlockScratch> scratch(new BlockScratch);
+#pragma omp single
+    {
+      const auto threads = static_cast<std::size_t>(omp_get_num_threads());
+      const bool live_split = live_.visited() && live_.covers(n);
+      const std::uint32_t* row_first = live_split ? live_.first() : neighbours_.first_rows().data();
+      const bool resplit =
+          split_.prepare(threads, n, rows, thread_shares, row_first, neighbours_.wall_rows_start().data());
+      crossing_.resize(threads);
+      if (resplit || crossing_floor_.size() != threads) crossing_floor_.assign(threads, kFloorUnknown);
+      crossing_done.reset(new std::atomic<bool>[threads]);
+      for (std::size_t u = 0; u < threads; ++u) crossing_done[u].store(false, std::memory_order_relaxed);
+    }
+    run_range(static_cast<std::size_t>(omp_get_thread_num()), dt, *scratch, crossing_done.get(), late_share, bad_row,
+              batched);
+  }
+  if (late_share.load()) throw RunError("internal error: a crossing share after its list was final (force_pass)");
+  batched_rows_ = batched;
+  body_terms_ready_ = true;
+  live_.count_pass();
+  if (bad_row < rows) throw_bad_row(bad_row);
+  collect_forces();
+}
+
+void Simulation::prepare_pass() {
+  // The ball records, the hill parameter sets and the live rows (and their records) the pass reads.
+  const std::size_t rows = contacts.size();
+  const std::size_t n = balls.size();
   const bool terms_ready = body_terms_ready_ && ball_kin_.size() == n;
   if (!terms_ready || hill_sets_stale_ || row_hill_set_.size() != rows) refresh_param_sets();
   if (ball_kin_.size() != n) drop_records();
@@ -1133,95 +1178,80 @@ void Simulation::force_pass(double dt) {
   if (records && !live_.records_ready() && steps_ahead_ >= kRecordSteps)
     live_.build_records(contacts, row_hill_set_.data(), n);
   live_.count_record_pass();
-  std::unique_ptr<std::atomic<bool>[]> crossing_done;  // per thread: its crossing list is final
-  std::atomic<bool> late_share{false};
-#pragma omp parallel reduction(min : bad_row) reduction(+ : batched) if (n > kParallelMin)
-  {
-    // ≈ 60 kB: on the heap, not the thread's stack. Default-initialised (make_unique would zero it on
-    // every pass): every lane value a law or the scatter uses is written before it is read.
-    std::unique_ptr<BlockScratch> scratch(new BlockScratch);
-#pragma omp single
-    {
-      const auto threads = static_cast<std::size_t>(omp_get_num_threads());
-      const bool live_split = live_.visited() && live_.covers(n);
-      const std::uint32_t* row_first = live_split ? live_.first() : neighbours_.first_rows().data();
-      const bool resplit =
-          split_.prepare(threads, n, rows, thread_shares, row_first, neighbours_.wall_rows_start().data());
-      crossing_.resize(threads);
-      if (resplit || crossing_floor_.size() != threads) crossing_floor_.assign(threads, kFloorUnknown);
-      crossing_done.reset(new std::atomic<bool>[threads]);
-      for (std::size_t u = 0; u < threads; ++u) crossing_done[u].store(false, std::memory_order_relaxed);
+}
+
+void Simulation::run_range(std::size_t t, double dt, BlockScratch& scratch, std::atomic<bool>* crossing_done,
+                           std::atomic<bool>& late_share, std::size_t& bad_row, std::int64_t& batched) {
+  // Thread t's range of balls (force_pass), its crossing shares announced to the threads above as
+  // soon as they are final, then the end of its balls' sums.
+  const std::size_t block = std::max<std::size_t>(1, balls_per_block);
+  const std::size_t first = split_.begin(t), last = split_.end(t);
+  std::vector<CrossShare>& crossing = crossing_[t];
+  crossing.clear();
+  // One thread needs no timing: its share is the whole.
+  const bool timed = omp_get_num_threads() > 1;
+  const double busy_from = timed ? omp_get_wtime() : 0.0;
+  // The lowest ball of the range with a row into a later range (made once per split: the rows do
+  // not change until the next). Below it the thread adds no crossing share, and from there its list
+  // is final and announced (crossing_done), long before its pass ends: the blocks run from the
+  // last down, and the crossing rows are those of its top layer of balls: only its top row_span balls
+  // (NeighbourList::row_span) can have one, and the last range has none.
+  if (crossing_floor_[t] == kFloorUnknown) crossing_floor_[t] = crossing_floor(first, last);
+  const std::size_t floor = crossing_floor_[t];
+  bool announced = false;
+  std::size_t announced_size = 0;
+  auto announce = [&] {
+    crossing_done[t].store(true, std::memory_order_release);
+    announced = true;
+    announced_size = crossing.size();
+  };
+  if (floor >= last) announce();
+  if (last > first)
+    for (std::size_t a = first + (last - first - 1) / block * block;; a -= block) {
+      force_block(a, std::min(last, a + block), last, dt, scratch, crossing, bad_row, batched);
+      if (!announced && a <= floor) announce();
+      if (a == first) break;
     }
-    const auto t = static_cast<std::size_t>(omp_get_thread_num());
-    const std::size_t first = split_.begin(t), last = split_.end(t);
-    std::vector<CrossShare>& crossing = crossing_[t];
-    crossing.clear();
-    // One thread needs no timing: its share is the whole.
-    const bool timed = omp_get_num_threads() > 1;
-    const double busy_from = timed ? omp_get_wtime() : 0.0;
-    // The lowest ball of the range with a row into a later range (made once per split: the rows do
-    // not change until the next). Below it the thread adds no crossing share, and from there its list
-    // is final and announced (crossing_done), long before its pass ends: the blocks run from the
-    // last down, and the crossing rows are those of its top layer of balls: only its top row_span balls
-    // (NeighbourList::row_span) can have one, and the last range has none.
-    if (crossing_floor_[t] == kFloorUnknown) {
-      std::size_t floor = last;
-      if (last < n) {
-        const std::vector<std::uint32_t>& rows_of = neighbours_.first_rows();
-        for (std::size_t a = last - std::min(last - first, neighbours_.row_span()); a < last && floor == last; ++a)
-          if (rows_of[a + 1] > rows_of[a] && contacts.key[rows_of[a + 1] - 1].b >= last) floor = a;
-      }
-      crossing_floor_[t] = floor;
-    }
-    const std::size_t floor = crossing_floor_[t];
-    bool announced = false;
-    std::size_t announced_size = 0;
-    auto announce = [&] {
-      crossing_done[t].store(true, std::memory_order_release);
-      announced = true;
-      announced_size = crossing.size();
-    };
-    if (floor >= last) announce();
-    if (last > first)
-      for (std::size_t a = first + (last - first - 1) / block * block;; a -= block) {
-        force_block(a, std::min(last, a + block), last, dt, *scratch, crossing, bad_row, batched);
-        if (!announced && a <= floor) announce();
-        if (a == first) break;
-      }
-    if (!announced) announce();
-    // (A share added after the list was announced would be a wrong floor: another thread may have read
-    // the list already. Never seen; checked, as it costs nothing.)
-    if (crossing.size() != announced_size) late_share.store(true, std::memory_order_relaxed);
-    // The end of the range's force sums, by the thread itself, in their order (force_pass): the
-    // crossing shares into its balls from the ranges below, the last range's first (each list once
-    // its thread announced it: no wait in practice), then its balls' wall rows in row order
-    // (wall_block: each row's result depends on no other row, nor on the batch it falls into).
-    for (std::size_t u = t; u-- > 0;) {
-      for (int spin = 0; !crossing_done[u].load(std::memory_order_acquire); ++spin)
-        if (spin > 1000) std::this_thread::yield();  // (more threads than cores: let the other run)
-      add_crossing(crossing_[u], first, last);
-    }
-    const std::size_t k0 = neighbours_.wall_rows_start()[first], k1 = neighbours_.wall_rows_start()[last];
-    if (k1 > k0) {
-      wall_block(k0, k1, dt, *scratch, bad_row, batched);
-      add_wall_rows(k0, k1);
-    }
-    if (timed) split_.add_busy(t, omp_get_wtime() - busy_from);  // [s]
+  if (!announced) announce();
+  // (A share added after the list was announced would be a wrong floor: another thread may have read
+  // the list already. Never seen; checked, as it costs nothing.)
+  if (crossing.size() != announced_size) late_share.store(true, std::memory_order_relaxed);
+  // The end of the range's force sums, by the thread itself, in their order (force_pass): the
+  // crossing shares into its balls from the ranges below, the last range's first (each list once
+  // its thread announced it: no wait in practice), then its balls' wall rows in row order
+  // (wall_block: each row's result depends on no other row, nor on the batch it falls into).
+  for (std::size_t u = t; u-- > 0;) {
+    for (int spin = 0; !crossing_done[u].load(std::memory_order_acquire); ++spin)
+      if (spin > 1000) std::this_thread::yield();  // (more threads than cores: let the other run)
+    add_crossing(crossing_[u], first, last);
   }
-  if (late_share.load()) throw RunError("internal error: a crossing share after its list was final (force_pass)");
-  batched_rows_ = batched;
-  body_terms_ready_ = true;
-  live_.count_pass();
-  if (bad_row < rows) {
-    const ContactKey& key = contacts.key[bad_row];
-    std::ostringstream msg;
-    msg << "non-finite contact force at step " << steps + 1 << " between ball " << balls.id[key.a] << " and "
-        << (key.kind == ContactKind::BallBall ? "ball " + std::to_string(balls.id[key.b])
-                                              : "wall '" + walls.walls[key.b].name + "'")
-        << " (gap " << contacts.gap[bad_row] << " m): the run is unstable; reduce the time step";
-    throw RunError(msg.str());
+  const std::size_t k0 = neighbours_.wall_rows_start()[first], k1 = neighbours_.wall_rows_start()[last];
+  if (k1 > k0) {
+    wall_block(k0, k1, dt, scratch, bad_row, batched);
+    add_wall_rows(k0, k1);
   }
-  collect_forces();
+  if (timed) split_.add_busy(t, omp_get_wtime() - busy_from);  // [s]
+}
+
+std::size_t Simulation::crossing_floor(std::size_t first, std::size_t last) const {
+  std::size_t floor = last;
+  if (last < balls.size()) {
+    const std::vector<std::uint32_t>& rows_of = neighbours_.first_rows();
+    for (std::size_t a = last - std::min(last - first, neighbours_.row_span()); a < last && floor == last; ++a)
+      if (rows_of[a + 1] > rows_of[a] && contacts.key[rows_of[a + 1] - 1].b >= last) floor = a;
+  }
+  return floor;
+}
+
+void Simulation::throw_bad_row(std::size_t bad_row) const {
+  // (The gap column is written for a row whose force is not finite: store_row.)
+  const ContactKey& key = contacts.key[bad_row];
+  std::ostringstream msg;
+  msg << "non-finite contact force at step " << steps + 1 << " between ball " << balls.id[key.a] << " and "
+      << (key.kind == ContactKind::BallBall ? "ball " + std::to_string(balls.id[key.b])
+                                            : "wall '" + walls.walls[key.b].name + "'")
+      << " (gap " << contacts.gap[bad_row] << " m): the run is unstable; reduce the time step";
+  throw RunError(msg.str());
 }
 
 void Simulation::add_crossing(const std::vector<CrossShare>& list, std::size_t first, std::size_t last) {

@@ -11,6 +11,7 @@
 // Lab-test drivers and the scenario runner use only this public API.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -241,6 +242,8 @@ class Simulation {
   // The inputs of a batch's lanes (ball-ball rows of force_block), from their rows and the records of
   // their two balls, when the batch runs.
   void fill_lanes(ContactBatch& batch, bool hill) const;
+  void fill_ball_lanes(ContactBatch& batch, bool hill) const;  // what the lanes read of their balls
+  void fill_row_lanes(ContactBatch& batch, bool hill) const;   // and of their rows
   // A batch lane's results as a row outcome (wall_row: a ball-wall lane of wall_block).
   RowOutcome lane_outcome(const ContactBatch& batch, std::size_t lane, bool wall_row) const;
   // store_row for a lane that the lanes marked kQuick (the contact stays, its force is finite):
@@ -256,6 +259,16 @@ class Simulation {
   // bad_row: the lowest row with a non-finite force; batched: + the rows that went through a batch.
   void force_block(std::size_t a0, std::size_t a1, std::size_t range_end, double dt, BlockScratch& scratch,
                    std::vector<CrossShare>& crossing, std::size_t& bad_row, std::int64_t& batched);
+  // Before the force pass's threads start: the ball records, the hill parameter sets, the live rows.
+  void prepare_pass();
+  // Thread t's part of the force pass (force_pass): its blocks, its crossing list (crossing_done[t]
+  // once final; late_share: a share came after), the crossing shares into its balls, its wall rows.
+  void run_range(std::size_t t, double dt, BlockScratch& scratch, std::atomic<bool>* crossing_done,
+                 std::atomic<bool>& late_share, std::size_t& bad_row, std::int64_t& batched);
+  // The lowest ball of balls first..last-1 with a ball-ball row into a later range (last: none).
+  std::size_t crossing_floor(std::size_t first, std::size_t last) const;
+  // RunError for the row with a non-finite force.
+  [[noreturn]] void throw_bad_row(std::size_t bad_row) const;
   // The wall rows k0..k1 (of NeighbourList::wall_rows): existing linear contacts that touch their
   // wall through a linear batch (the wall's geometry given), the rest row by row (force_row). Each
   // row's results go to its columns and share_moment_; collect_forces() sums them in row order, so
