@@ -7,14 +7,13 @@
 #include <atomic>
 #include <bit>
 #include <cmath>
-#include <cstring>
+#include <cstddef>
 #include <limits>
 #include <map>
 #include <memory>
 #include <numeric>
 #include <sstream>
 #include <thread>
-#include <type_traits>
 
 #include "hilldem/contact/cell_grid.hpp"
 #include "hilldem/core/error.hpp"
