@@ -7,14 +7,13 @@
 #include <atomic>
 #include <bit>
 #include <cmath>
-#include <cstring>
+#include <cstddef>
 #include <limits>
 #include <map>
 #include <memory>
 #include <numeric>
 #include <sstream>
 #include <thread>
-#include <type_traits>
 
 #include "hilldem/contact/cell_grid.hpp"
 #include "hilldem/core/error.hpp"
@@ -81,7 +80,7 @@ double Simulation::next_timestep() const {
 
 double Simulation::skin() const {
   if (settings.skin > 0.0) return settings.skin;
-  if (skin_known_) return skin_;  // (a serial sum over the radii: ≈ 1 % of a step at 100,800 spheres)
+  if (skin_known_) return skin_;  // (a serial sum over the radii: kept while the radii cannot change)
   if (balls.size() == 0) return 0.0;
   const double sum = std::accumulate(balls.radius.begin(), balls.radius.end(), 0.0);
   return 0.1 * 2.0 * sum / static_cast<double>(balls.size());
@@ -92,7 +91,7 @@ void Simulation::step_once(bool last) {
     step_body(last);
   } catch (...) {
     sync_ball_columns();  // the state where the run stopped, for whoever catches this
-    if (live_records_ready_) sync_live_records();
+    if (live_.records_ready()) live_.sync_records(contacts);
     throw;
   }
 }
@@ -125,12 +124,12 @@ void Simulation::step_body(bool last) {
     i_scaled = scaled_inertia_.data();
   }
   // §1.2 steps 1-2
-  if (records_current_ && ball_kin_.size() == balls.size()) {
+  if (ball_kin_.current() && ball_kin_.size() == balls.size()) {
     advance_records(dt, m_scaled, i_scaled, watched);
   } else {
     drop_records();
     advance_balls(balls, MotionSettings{settings.gravity, settings.local_damping}, dt, m_scaled, i_scaled,
-                  contact_sums());
+                  ball_kin_.contact_sums(balls.size()));
   }
   for (Wall& w : walls.walls) {
     // Bound on how far any point of the wall moved (for the neighbour-list check).
@@ -139,8 +138,8 @@ void Simulation::step_body(bool last) {
       for (const Vec3& v : w.vertex) reach = std::max(reach, norm(v - w.rotation_center));
     else if (w.shape == WallShape::Plane && norm2(w.spin) > 0.0)
       reach = std::numeric_limits<double>::infinity();
-    if (norm2(w.spin) > 0.0) wall_travel_ += norm(w.spin) * dt * reach;
-    wall_travel_ += (norm(w.velocity) + std::abs(w.radial_velocity)) * dt;
+    if (norm2(w.spin) > 0.0) neighbours_.add_wall_travel(norm(w.spin) * dt * reach);
+    neighbours_.add_wall_travel((norm(w.velocity) + std::abs(w.radial_velocity)) * dt);
     advance_wall(w, dt);
   }
   rebuild_if_needed();  // step 3
@@ -154,7 +153,7 @@ void Simulation::step_body(bool last) {
 ContactGeometry Simulation::geometry(std::size_t c) const {
   const ContactKey& k = contacts.key[c];
   // (Between steps the columns hold the positions; within an unwatched step the records.)
-  auto position = [&](std::size_t i) -> const Vec3& { return columns_stale_ ? ball_kin_[i].position : balls.position[i]; };
+  auto position = [&](std::size_t i) -> const Vec3& { return ball_kin_.columns_stale() ? ball_kin_[i].position : balls.position[i]; };
   const Vec3& x1 = position(k.a);
   const double r1 = balls.radius[k.a];
   ContactGeometry g;
@@ -179,10 +178,6 @@ ContactGeometry Simulation::geometry(std::size_t c) const {
   }
   g.point = x1 + g.normal * (r1 + 0.5 * g.gap);  // centre of the gap/overlap (spec §1.1)
   return g;
-}
-
-std::uint64_t Simulation::piece2_groups(const ContactKey& k) const {
-  return k.kind == ContactKind::BallBall ? balls.groups[k.b] : walls.walls[k.b].groups;
 }
 
 void Simulation::compute_mapping(ContactStore& store, std::size_t c) const {
@@ -228,7 +223,7 @@ void Simulation::create_contact(std::size_t c, const Vec3& normal) {
 }
 
 void Simulation::refresh_param_sets() {
-  if (live_records_ready_) sync_live_records();  // (the records hold the rows' sets)
+  if (live_.records_ready()) live_.sync_records(contacts);  // (the records hold the rows' sets)
   // The distinct parameters, told apart by their bits, so that each row's set holds exactly its
   // parameters. Rows mostly share their neighbour's set: one comparison, and a map lookup only when
   // the parameters change along the rows.
@@ -259,132 +254,30 @@ void Simulation::refresh_mappings() {
   for (std::size_t c = 0; c < contacts.size(); ++c) compute_mapping(contacts, c);
 }
 
-void Simulation::wrap_positions() {
-  const PeriodicBox& box = settings.box;
-  if (!box.any()) return;
-  const Vec3 l = box.length();
-  for (Vec3& x : balls.position)
-    for (int d = 0; d < 3; ++d)
-      if (box.periodic[d]) {
-        x[d] = box.lo[d] + std::fmod(x[d] - box.lo[d], l[d]);
-        if (x[d] < box.lo[d]) x[d] += l[d];
-        if (x[d] >= box.hi[d]) x[d] -= l[d];
-      }
-}
-
 void Simulation::advance_records(double dt, const double* inertial_mass, const double* inertial_inertia,
                                  bool write_columns) {
-  // One pass over the balls where there were three (the law of motion on the columns, the travel
-  // check, the force pass's copy into the records), ≈ 660 bytes streamed a ball a step against ≈ 420
-  // here: 1.04 x at 100,800 spheres (docs/performance.md, fifteenth session). The law is
-  // advance_balls's (motion::step_ball). The travel since the live rows is measured ball by ball (the
-  // check's expression); that since the neighbour list only bounded (travel_bound_, no reference
-  // position read), exactly by rebuild_if_needed when the bound reaches half the skin.
-  using namespace motion;
+  // The travel since the live rows is measured ball by ball (the check's expression), or bounded
+  // without it while the bound, grown by four steps like the last, stays within the slack; that
+  // since the neighbour list only bounded (NeighbourList::travel_bound, no reference position read),
+  // exactly by rebuild_if_needed when the bound reaches half the skin.
   const std::size_t n = balls.size();
-  const double alpha = settings.local_damping;
-  const V4 gravity = load(settings.gravity);
-  const bool live_list = live_ready_ && position_at_live_.size() == n;
-  // The travel since the live rows ball by ball (reading each ball's position then), or bounded
-  // without it while the bound, grown by four steps like the last, stays within the slack.
-  const bool bounded = live_list && live_bound_valid_ && live_travel_ + 4.0 * live_growth_ <= live_slack_;
+  const bool live_list = live_.has_positions(n);
+  const bool bounded = live_list && live_.bound_holds();
   const bool live = live_list && !bounded;
-  if (!applied_known_) {  // (once per cycle() call: nothing changes them until then)
-    const auto zero = [](const std::vector<Vec3>& v) {
-      const Vec3 z{};
-      return std::all_of(v.begin(), v.end(), [&z](const Vec3& x) { return std::memcmp(&x, &z, sizeof z) == 0; });
-    };
-    applied_zero_ = zero(balls.applied_force) && zero(balls.applied_moment);
-    applied_known_ = true;
-  }
-  BallKin* kin = ball_kin_.data();
-  const motion::ContactSums* sums = contact_sums();
-  // [m²/s²], [m²], [m²] (a NaN wins: see rebuild_if_needed)
-  double max_v2 = 0.0, max_x2 = 0.0, worst_live = 0.0;
-  // Each thread's balls: in proportion to the threads' shares of the force pass (thread_share_:
-  // equal, given or by their measured speeds), so that a thread on a slower core is not the one
-  // every other waits for. Which thread moves a ball changes no result.
-  const std::vector<double>& shares = thread_share_;  // (not changed during the pass)
-  auto pass = [&](auto applied) {
-#pragma omp parallel if (n > kParallelMin)
-    {
-      double mine_v2 = 0.0, mine_x2 = 0.0, mine_live = 0.0;
-      const auto threads = static_cast<std::size_t>(omp_get_num_threads());
-      const auto t = static_cast<std::size_t>(omp_get_thread_num());
-      std::size_t i0 = n * t / threads, i1 = n * (t + 1) / threads;
-      if (shares.size() == threads) {
-        double before = 0.0;
-        for (std::size_t s = 0; s < t; ++s) before += shares[s];
-        const auto at = [n](double f) { return static_cast<std::size_t>(static_cast<double>(n) * std::clamp(f, 0.0, 1.0)); };
-        i0 = t == 0 ? 0 : at(before);
-        i1 = t + 1 == threads ? n : at(before + shares[t]);
-      }
-      for (std::size_t i = i0; i < i1; ++i) {
-        BallKin& k = kin[i];
-        V4 x = load(k.position), v = load(k.velocity), w = load(k.spin);
-        const V4 cf = sums ? sums[i].force : load(balls.contact_force[i]);
-        const V4 cm = sums ? sums[i].moment : load(balls.contact_moment[i]);
-        step_ball<decltype(applied)::value>(balls, i, gravity, alpha, dt, k.mass, k.inertia, inertial_mass,
-                                            inertial_inertia, cf, cm, x, v, w);
-        store(k.velocity, v);
-        store(k.spin, w);
-        store(k.position, x);
-        if (write_columns) {
-          store(balls.velocity[i], v);
-          store(balls.spin[i], w);
-          store(balls.position[i], x);
-        }
-        const double v2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-        const double x2 = x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
-        if (!(v2 <= mine_v2)) mine_v2 = v2;
-        if (!(x2 <= mine_x2)) mine_x2 = x2;
-        if (live) {
-          const double l2 = norm2(k.position - position_at_live_[i]);
-          if (!(l2 <= mine_live)) mine_live = l2;
-        }
-      }
-#pragma omp critical(hilldem_record_motion)
-      {
-        if (!(mine_v2 <= max_v2)) max_v2 = mine_v2;
-        if (!(mine_x2 <= max_x2)) max_x2 = mine_x2;
-        if (!(mine_live <= worst_live)) worst_live = mine_live;
-      }
-    }
-  };
-  // Without the applied loads' 48 bytes a ball when all are zero.
-  if (applied_zero_) pass(std::false_type{});
-  else pass(std::true_type{});
-  columns_stale_ = !write_columns;
+  const BallRecords::Motion moved =
+      ball_kin_.advance(balls, settings.gravity, settings.local_damping, dt, inertial_mass, inertial_inertia,
+                        write_columns, split_.shares(), live, live_.positions());
   // No ball moved farther than |V|max Δt this step, but for the rounding of x + V Δt (below
   // 2.3e-16 |x| a step) and of |V|: a margin of 1e-9 of the first and 1e-15 |x|max [m]. A NaN stays.
-  const double growth = std::sqrt(max_v2) * dt * (1.0 + 1e-9) + 1e-15 * std::sqrt(max_x2);
-  travel_bound_ += growth;
-  motion_travel_known_ = true;
-  if (live) live_travel_ = std::sqrt(worst_live);  // (exact)
-  else if (bounded) live_travel_ += growth;
-  live_growth_ = growth;
-  live_bound_valid_ = live_list;
-  live_travel_known_ = live_list;
-}
-
-void Simulation::sync_ball_columns() {
-  sync_sum_columns();
-  if (!columns_stale_) return;
-  const std::size_t n = std::min(balls.size(), ball_kin_.size());  // (the same, while the columns lag)
-#pragma omp parallel for schedule(static) if (n > kParallelMin)
-  for (std::size_t i = 0; i < n; ++i) {
-    balls.position[i] = ball_kin_[i].position;
-    balls.velocity[i] = ball_kin_[i].velocity;
-    balls.spin[i] = ball_kin_[i].spin;
-  }
-  columns_stale_ = false;
+  const double growth = std::sqrt(moved.max_v2) * dt * (1.0 + 1e-9) + 1e-15 * std::sqrt(moved.max_x2);
+  neighbours_.grow_travel_bound(growth);
+  live_.after_motion(live_list, live, bounded, moved.worst_live, growth);
 }
 
 void Simulation::rebuild_if_needed() {
-  const bool measured = motion_travel_known_;  // by advance_records, this step
-  motion_travel_known_ = false;
-  if (!rebuild_needed_ && position_at_build_.size() == balls.size()) {
-    if (records_current_ && !skin_known_) {  // (the radii stay until the records are dropped)
+  const bool measured = neighbours_.take_motion_bound();  // by advance_records, this step
+  if (!neighbours_.stale(balls.size())) {
+    if (ball_kin_.current() && !skin_known_) {  // (the radii stay until the records are dropped)
       skin_ = skin();
       skin_known_ = true;
     }
@@ -392,14 +285,16 @@ void Simulation::rebuild_if_needed() {
     // A pair outside the list was farther than `skin` beyond proximity at the rebuild. The record
     // motion's bound first: the exact travel is at most the bound, so a bound within the limit gives
     // the exact check's answer without a pass over the positions (a NaN bound fails, and goes on).
-    if (measured && travel_bound_ <= half && travel_bound_ + wall_travel_ <= 2.0 * half) return;
+    if (measured && neighbours_.holds(neighbours_.travel_bound(), half)) return;
     // The largest squared travel since the rebuild [m²], exactly; a NaN wins (not std::max, which
-    // would drop it). Parallel: the maximum does not depend on the order, and a NaN asks for a rebuild,
-    // which ends the run (rebuild). And the largest since the live rows were made (refresh_live_rows), while they are. (The
-    // positions from the records when the columns lag behind them.)
+    // would drop it). Parallel: the maximum does not depend on the order, and a NaN asks for a
+    // rebuild, which ends the run (NeighbourList::rebuild). And the largest since the live rows were
+    // made, while they are. (The positions from the records when the columns lag behind them.)
     const std::size_t n = balls.size();
-    const bool from_records = columns_stale_;
-    const bool live = live_ready_ && position_at_live_.size() == n;
+    const bool from_records = ball_kin_.columns_stale();
+    const bool live = live_.has_positions(n);
+    const Vec3* at_live = live_.positions();
+    const Vec3* at_build = neighbours_.position_at_build().data();
     double worst = 0.0, worst_live = 0.0;
 #pragma omp parallel if (n > kParallelMin)
     {
@@ -407,10 +302,10 @@ void Simulation::rebuild_if_needed() {
 #pragma omp for schedule(static) nowait
       for (std::size_t i = 0; i < n; ++i) {
         const Vec3& x = from_records ? ball_kin_[i].position : balls.position[i];
-        const double d2 = norm2(x - position_at_build_[i]);
+        const double d2 = norm2(x - at_build[i]);
         if (!(d2 <= mine)) mine = d2;
         if (live) {
-          const double l2 = norm2(x - position_at_live_[i]);
+          const double l2 = norm2(x - at_live[i]);
           if (!(l2 <= mine_live)) mine_live = l2;
         }
       }
@@ -420,134 +315,40 @@ void Simulation::rebuild_if_needed() {
         if (!(mine_live <= worst_live)) worst_live = mine_live;
       }
     }
-    live_travel_ = std::sqrt(worst_live);
-    live_travel_known_ = live;
-    live_bound_valid_ = live;
+    live_.measured(live, worst_live);
     const double ball_travel = std::sqrt(worst);
-    travel_bound_ = ball_travel;  // (exact now: the record motion grows it from here)
-    if (ball_travel <= half && ball_travel + wall_travel_ <= 2.0 * half) return;
+    neighbours_.set_travel_bound(ball_travel);  // (exact now: the record motion grows it from here)
+    if (neighbours_.holds(ball_travel, half)) return;
   }
   drop_records();  // the rebuild reads the columns, and wraps the positions into a periodic box
   rebuild(settings.proximity);
 }
 
 void Simulation::rebuild(double proximity) {
-  if (live_records_ready_) sync_live_records();  // (the rows are made anew, their history by key)
-  // A ball that has flown off to infinity (a blow-up: Δt too large, or a state that cannot be
-  // integrated) has no cell: stop here with the ball and the step, as the force pass does for a
-  // non-finite force (which would come only after the list). Every list is made here, and a
-  // non-finite travel (rebuild_if_needed) always asks for one. Before the wrap, so that the message
-  // gives the position the run reached.
-  for (std::size_t i = 0; i < balls.size(); ++i) {
-    const Vec3& x = balls.position[i];
-    if (!std::isfinite(norm2(x) + balls.radius[i]))  // (|x|² overflows too: no distance is finite then)
-      throw RunError("ball " + std::to_string(balls.id[i]) + " has a non-finite position at step " +
-                     std::to_string(steps) + " (" + std::to_string(x.x) + ", " + std::to_string(x.y) + ", " +
-                     std::to_string(x.z) + " m): the run is unstable; reduce the time step");
-  }
-  wrap_positions();
+  if (live_.records_ready()) live_.sync_records(contacts);  // (the rows are made anew, their history by key)
   const double reach = proximity + skin();
-  std::vector<PairCandidate> candidates = find_pair_candidates(balls.position, balls.radius, reach, settings.box);
-  std::vector<ContactKey> keys;
-  keys.reserve(candidates.size());
-  for (const PairCandidate& p : candidates) keys.push_back({p.i, ContactKind::BallBall, p.j});
-  std::vector<std::pair<ContactKey, ImageCode>> wall_keys;
-  for (std::uint32_t w = 0; w < walls.size(); ++w)
-    for (std::uint32_t i = 0; i < balls.size(); ++i) {
-      const auto touch = wall_touch(walls.walls[w], balls.position[i], balls.radius[i]);
-      if (touch && touch->gap <= reach) wall_keys.push_back({{i, ContactKind::BallWall, w}, kNoImage});
-    }
-  // Merge the two candidate lists into one sorted list (ball-ball keys are already sorted).
-  std::vector<std::pair<ContactKey, ImageCode>> all;
-  all.reserve(keys.size() + wall_keys.size());
-  for (std::size_t k = 0; k < keys.size(); ++k) all.push_back({keys[k], candidates[k].image});
-  all.insert(all.end(), wall_keys.begin(), wall_keys.end());
-  std::sort(all.begin(), all.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
-
-  // Merge with the existing rows (also sorted): history survives. An old row that is no longer a
-  // candidate is kept only while it must be: a wet hill contact (spec §2.5).
-  ContactStore next;
-  next.key.reserve(all.size());
-  unassigned_pairs_ = 0;
-  std::size_t o = 0;
-  auto keep_old_if_needed = [&](std::size_t i) {
-    if (contacts.exists[i] && contacts.model[i] == ModelKind::Hill && contacts.moisture[i] == Moisture::Wet) {
-      next.append_row(contacts, i);
-      const ContactKey& k = contacts.key[i];
-      if (k.kind == ContactKind::BallBall)
-        next.image.back() = nearest_image(balls.position[k.a], balls.position[k.b], settings.box);
-    }
-  };
-  for (const auto& [key, image] : all) {
-    while (o < contacts.size() && contacts.key[o] < key) keep_old_if_needed(o++);
-    if (o < contacts.size() && contacts.key[o] == key) {
-      next.append_row(contacts, o++);
-      next.image.back() = image;
-      continue;
-    }
-    const int r = table.match(key.kind, balls.groups[key.a], piece2_groups(key));
-    if (r < 0) {
-      ++unassigned_pairs_;
-      continue;
-    }
-    const ModelRule& rule = table.rules[r];
-    next.append_new(key, image, r, rule.model, rule.linear, rule.hill, Vec3{0, 0, 1});
-    compute_mapping(next, next.size() - 1);
-  }
-  while (o < contacts.size()) keep_old_if_needed(o++);
-  contacts = std::move(next);
+  neighbours_.rebuild(contacts, balls, walls, table, settings.box, reach, steps,
+                      [this](ContactStore& store, std::size_t c) { compute_mapping(store, c); });
   build_row_lists();
-  position_at_build_ = balls.position;
-  travel_bound_ = 0.0;
-  wall_travel_ = 0.0;
-  rebuild_needed_ = false;
+  neighbours_.built(balls.position);
   body_terms_ready_ = false;
-  ++rebuilds_;
 }
 
 void Simulation::build_row_lists() {
-  // The per-ball row lists of the force sum (see first_rows_, late_rows_, wall_rows_), in row order.
-  const std::size_t n = balls.size();
-  const std::size_t rows = contacts.size();
-  if (rows > static_cast<std::size_t>(std::numeric_limits<std::uint32_t>::max()))
-    throw RunError("too many neighbour pairs (" + std::to_string(rows) + ") for one process");
-  crossing_floor_.clear();  // (made again from these rows: force_pass)
-  first_rows_.assign(n + 1, 0);
-  late_rows_start_.assign(n + 1, 0);
-  wall_rows_start_.assign(n + 1, 0);
-  wall_rows_.clear();
-  row_span_ = 0;
-  for (std::size_t c = 0; c < rows; ++c) {
-    const ContactKey& k = contacts.key[c];
-    if (k.kind == ContactKind::BallBall) {
-      if (k.b > k.a) row_span_ = std::max<std::size_t>(row_span_, k.b - k.a);
-      ++first_rows_[k.a + 1];
-      ++late_rows_start_[k.b + 1];
-    } else {
-      wall_rows_.push_back(static_cast<std::uint32_t>(c));  // (sorted by ball: keys by kind, then a)
-      ++wall_rows_start_[k.a + 1];
-    }
-  }
-  for (std::size_t i = 0; i < n; ++i) {
-    first_rows_[i + 1] += first_rows_[i];
-    late_rows_start_[i + 1] += late_rows_start_[i];
-    wall_rows_start_[i + 1] += wall_rows_start_[i];
-  }
-  late_rows_.assign(late_rows_start_[n], 0);
-  std::vector<std::uint32_t> late_fill(late_rows_start_.begin(), late_rows_start_.end() - 1);
-  for (std::size_t c = 0; c < rows; ++c) {
-    const ContactKey& k = contacts.key[c];
-    if (k.kind == ContactKind::BallBall) late_rows_[late_fill[k.b]++] = static_cast<std::uint32_t>(c);
-  }
-  share_moment_.assign(rows, Vec3{});
-  live_ready_ = false;  // (new rows)
-  ball_k_tran_.assign(n, 0.0);
-  ball_k_rot_.assign(n, 0.0);
+  neighbours_.build_row_lists(contacts, balls.size());
+  // What the force pass keeps per row or per ball of these rows, made again.
+  crossing_floor_.clear();
+  share_moment_.assign(contacts.size(), Vec3{});
+  live_.invalidate();
+  ball_k_tran_.assign(balls.size(), 0.0);
+  ball_k_rot_.assign(balls.size(), 0.0);
   stiffness_ready_ = false;
 }
 
 CycleState Simulation::cycle_state() const {
-  return {forces_ready_, rebuild_needed_, rebuilds_, unassigned_pairs_, position_at_build_, wall_travel_};
+  const NeighbourList& list = neighbours_;
+  return {forces_ready_,         list.rebuild_needed(),    list.rebuilds(), list.unassigned_pairs(),
+          list.position_at_build(), list.wall_travel()};
 }
 
 void Simulation::restore_cycle_state(CycleState s) {
@@ -558,17 +359,14 @@ void Simulation::restore_cycle_state(CycleState s) {
     if (k.a >= balls.size() || (k.kind == ContactKind::BallBall && k.b >= balls.size()) ||
         (k.kind == ContactKind::BallWall && k.b >= walls.size()))
       throw RunError("cycle state: a contact row refers to a body that does not exist");
-  // The force pass finds a ball's rows by position in the sorted list (first_rows_).
+  // The force pass finds a ball's rows by position in the sorted list (NeighbourList::first_rows).
   for (std::size_t c = 1; c < contacts.size(); ++c)
     if (!(contacts.key[c - 1] < contacts.key[c])) throw RunError("cycle state: contact rows are not sorted by key");
   forces_ready_ = s.forces_ready;
-  sums_current_ = false;  // the restored columns hold the sums the next step moves with
-  sum_columns_stale_ = false;
-  rebuild_needed_ = s.rebuild_needed || s.position_at_build.empty();
-  rebuilds_ = s.rebuilds;
-  unassigned_pairs_ = static_cast<std::size_t>(s.unassigned_pairs);
-  position_at_build_ = std::move(s.position_at_build);
-  wall_travel_ = s.wall_travel;
+  ball_kin_.forget_sums();  // the restored columns hold the sums the next step moves with
+  const bool rebuild_needed = s.rebuild_needed || s.position_at_build.empty();  // (before the move below)
+  neighbours_.restore(rebuild_needed, s.rebuilds, static_cast<std::size_t>(s.unassigned_pairs),
+                      std::move(s.position_at_build), s.wall_travel);
   body_terms_ready_ = false;
   build_row_lists();
 }
@@ -761,7 +559,7 @@ HILLDEM_INLINE void Simulation::store_kept_lane(std::size_t c, const ContactBatc
                                                bool want_stiffness, bool reported, bool history) {
   // The columns of store_row for a contact that stays (written in the same cases), straight from the
   // lanes: no RowOutcome and RowShare copied, no moments computed one lane at a time, no keys read
-  // again (docs/performance.md).
+  // again.
   using F = ContactBatch;
   if (history) {
     contacts.shear_state[c] = batch.get3(F::kShx, lane);
@@ -808,16 +606,14 @@ using lanes::transpose8;
 using lanes::widen8;
 #endif
 
-void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
+HILLDEM_INLINE void Simulation::fill_ball_lanes(ContactBatch& batch, bool hill) const {
   // Each lane's inputs: from the records of its two balls x2 − x1 (x2 with its periodic image), the
   // radii, velocities and spins, and for the hill law the sums of the two balls' terms; from its row
   // the last normal and shear force and the parameters. The ball values copied lane by lane are 28
-  // loads and 28 stores a lane, and this core stores about one value a cycle to different lines
-  // (≈ 1.3 cycles a field, docs/performance.md, twelfth session); with AVX-512 the records of eight
-  // lanes are loaded whole and transposed in registers, and each field is stored once for the eight
-  // lanes (1.05 x at 100,800 spheres). The arithmetic is the same (x2 − x1 and the sums, lane by
-  // lane), so the bits are those of the lane-by-lane copy. (AVX-512 gathers were slower than the
-  // copy here.)
+  // loads and 28 stores a lane, and a core stores about one value a cycle to different lines; with
+  // AVX-512 the records of eight lanes are loaded whole and transposed in registers, and each field
+  // is stored once for the eight lanes (docs/performance.md). The arithmetic is the same (x2 − x1 and
+  // the sums, lane by lane), so the bits are those of the lane-by-lane copy.
   using F = ContactBatch;
   const BallKin* kin = ball_kin_.data();
   const std::size_t n = batch.size();
@@ -895,11 +691,13 @@ void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
       batch.col(F::kCs)[lane] = ka.terms.shear + kb.terms.shear;
     }
   }
-  // The rows' own inputs. (From the row columns, eight rows' Vec3s loaded whole and transposed, and
-  // the parameters set for eight lanes at once, gave 1.000 x in cache, 16 pairs: not kept. From the
-  // live records, one aligned line a row, it pays: below.)
-  // A hill lane's history, parameter set and M: from its live record, or from
-  // the row columns.
+}
+
+HILLDEM_INLINE void Simulation::fill_row_lanes(ContactBatch& batch, bool hill) const {
+  using F = ContactBatch;
+  const std::size_t n = batch.size();
+  // The rows' own inputs. A hill lane's history, parameter set and M: from its live record (eight
+  // lanes at a time with AVX-512: one aligned line a row), or from the row columns.
   auto put_hill = [&](std::size_t lane, const Vec3& normal, const Vec3& shear, std::uint32_t set, Moisture m) {
     batch.put3(F::kNox, lane, normal);
     batch.put3(F::kSx, lane, shear);
@@ -908,7 +706,7 @@ void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
     batch.col(F::kDamp)[lane] = p.damp_con;
     batch.col(F::kWet)[lane] = m == Moisture::Wet ? 1.0 : 0.0;
   };
-  lane = 0;
+  std::size_t lane = 0;
 #if defined(__AVX512F__)
   if (hill) {
     // Eight lanes with live records at a time: the records loaded whole and transposed in registers
@@ -924,7 +722,7 @@ void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
     for (; lane + 8 <= n; lane += 8) {
       if (_mm512_cmp_epi64_mask(widen8(batch.slots() + lane), no_slot, _MM_CMPINT_NE) != 0xFF) break;  // (the rest lane by lane)
       __m512d r[8], c[8];
-      for (std::size_t k = 0; k < 8; ++k) r[k] = _mm512_load_pd(reinterpret_cast<const double*>(&live_records_[batch.slot(lane + k)]));
+      for (std::size_t k = 0; k < 8; ++k) r[k] = _mm512_load_pd(reinterpret_cast<const double*>(&live_.records()[batch.slot(lane + k)]));
       transpose8(r, c);  // c[1]: set and flags; c[2..4]: n̂_c; c[5..7]: F^h_s
       const F::Field history[6] = {F::kNox, F::kNoy, F::kNoz, F::kSx, F::kSy, F::kSz};
       for (int f = 0; f < 6; ++f) _mm512_store_pd(batch.col(history[f]) + lane, c[2 + f]);
@@ -944,7 +742,7 @@ void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
     if (hill) {
       const std::uint32_t slot = batch.slot(lane);
       if (slot != ContactBatch::kNoSlot) {
-        const LiveRecord& r = live_records_[slot];
+        const LiveRecord& r = live_.records()[slot];
         put_hill(lane, r.normal, r.shear, r.hill_set, r.moisture);
       } else {
         put_hill(lane, contacts.normal[c], contacts.shear_state[c], row_hill_set_[c], contacts.moisture[c]);
@@ -957,6 +755,11 @@ void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
       batch.col(F::kFric)[lane] = contacts.linear_params[c].fric;
     }
   }
+}
+
+void Simulation::fill_lanes(ContactBatch& batch, bool hill) const {
+  fill_ball_lanes(batch, hill);
+  fill_row_lanes(batch, hill);
 }
 
 void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_end, double dt, BlockScratch& scratch,
@@ -973,29 +776,23 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
   const BallKin* kin = ball_kin_.data();
   const ContactKey* keys = contacts.key.data();
   // Each ball's force and moment sums in one line, each a vector with a +0.0 fourth lane
-  // (motion::ContactSums): a row's share into a ball is one vector operation per sum where it was
-  // three scalar ones. The same additions component by component, so the same bits (≈ 1.04-1.06 x
-  // against two Vec3 columns, binaries in turn at 100,800 spheres; docs/performance.md, sixteenth
-  // session).
-  motion::ContactSums* __restrict sums = ball_sums_.data();
+  // (motion::ContactSums): a row's share into a ball is one vector operation per sum, not three
+  // scalar ones. The same additions component by component, so the same bits.
+  motion::ContactSums* __restrict sums = ball_kin_.sums();
   // Prefetch distances in rows (the pass runs down the rows; below). The row columns run downwards,
-  // and the hardware prefetcher follows descending streams poorly: perf put a fifth of the pair
-  // loop on the first loads of the history, parameter and flag columns. Asking for the history and
-  // parameters 32 rows ahead gave 1.11 x at 100,800 spheres (4 pairs; 8, 16 and 32 rows the same);
-  // the byte columns and the keys 128 rows ahead 1.07-1.09 x more there, but 0.97 x at 11,200 (the
-  // rows in the outer caches), hence only for more than 2^17 rows. (Asking for the flags every 16th
-  // row instead of every row, with no threshold, was 0.91 x at 100,800.) Below 2^17 rows nothing is
-  // asked for ahead at all: the prefetches' own work (≈ 30 instructions a row) cost more than they
-  // hid there: without them 1.031 x at 11,200 spheres (6 pairs; ≈ 50,000 rows), 1.059 x in cache
-  // (3,576 spheres, 6 pairs) and 1.015 x on a lab test (4 pairs) (tenth session).
+  // and the hardware prefetcher follows descending streams poorly, so the pair loop would wait on
+  // the first loads of the history, parameter and flag columns: the history and parameters are asked
+  // for 32 rows ahead, the byte columns and the keys 128 rows ahead. Only for more than 2^17 rows:
+  // below, the rows sit in the outer caches, and the prefetches' own work (≈ 30 instructions a row)
+  // costs more than they hide (the distances and the threshold: docs/performance.md).
   constexpr std::size_t kPrefetchRows = 16;
   constexpr std::size_t kPrefetchColumns = 32;
   constexpr std::size_t kPrefetchFlags = 128;
   constexpr std::size_t kPrefetchBalls = 8;
   constexpr std::size_t kPrefetchRecords = 64;
   const bool far = contacts.size() > (std::size_t{1} << 17);
-  const bool live = live_now_;  // the rows visited: the live rows (force_pass), or all (through force_row)
-  const bool records = live && live_records_ready_;  // the live rows through their records
+  const bool live = live_.visited();  // the rows visited: the live rows (force_pass), or all (through force_row)
+  const bool records = live && live_.records_ready();  // the live rows through their records
   using F = ContactBatch;
   ContactBatch& hill = scratch.hill;
   ContactBatch& linear = scratch.linear;
@@ -1042,12 +839,12 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
         RowShare share;
         store_row(c, lane_outcome(batch, lane, /*wall_row=*/false), want_stiffness, reported, share);
         add_share(c, share);
-        if (slot != ContactBatch::kNoSlot) load_live_record(slot);  // (store_row wrote the columns)
+        if (slot != ContactBatch::kNoSlot) live_.load_record(slot, contacts, row_hill_set_.data());  // (store_row wrote the columns)
         return;
       }
       // The shares from the lanes; a live record's history into the record.
       if (slot != ContactBatch::kNoSlot) {
-        LiveRecord& h = live_records_[slot];
+        LiveRecord& h = live_.records()[slot];
         h.shear = batch.get3(F::kShx, lane);
         h.normal = batch.get3(F::kNx, lane);
         if (batch.col(F::kRuptured)[lane] != 0.0) h.moisture = Moisture::Ruptured;
@@ -1102,7 +899,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
           _mm512_store_pd(a, _mm512_add_pd(_mm512_load_pd(a), share_a[k]));
           double* b = reinterpret_cast<double*>(sums + batch.ball2(lane + k));
           _mm512_store_pd(b, _mm512_add_pd(_mm512_load_pd(b), share_b[k]));
-          _mm512_mask_store_pd(reinterpret_cast<double*>(&live_records_[batch.slot(lane + k)]), 0xFC, history[k]);
+          _mm512_mask_store_pd(reinterpret_cast<double*>(&live_.records()[batch.slot(lane + k)]), 0xFC, history[k]);
         }
       }
     }
@@ -1118,8 +915,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
     const BallKin& ka = kin[a];
     if (far && a >= kPrefetchBalls) {
       // The record, force sums and row range of the ball some places down: the pass meets each ball
-      // first as the `a` of its rows, a descending stream (1.01-1.06 x at 100,800 spheres, three
-      // runs of the in-process alternation of `hilldem bench --alternate`, thirteenth session).
+      // first as the `a` of its rows, a descending stream.
       const std::size_t ahead = a - kPrefetchBalls;
       const char* record = reinterpret_cast<const char*>(kin + ahead);
       __builtin_prefetch(record);
@@ -1130,7 +926,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
         __builtin_prefetch(sums + ahead, 1);
       }
       // Its row range: of its live rows, or of all its rows.
-      __builtin_prefetch(live ? live_first_.data() + ahead : first_rows_.data() + ahead);
+      __builtin_prefetch(live ? live_.first() + ahead : neighbours_.first_rows().data() + ahead);
     }
     // Ball a's rows from the last down: k1 − 1 down to k0 of the row sequence row_at, its live rows
     // (live_rows) or all of its rows.
@@ -1140,8 +936,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
         if (far) {  // (nothing asked for ahead when the rows fit in the caches: see above)
           if (k >= kPrefetchRows) {
             // The ball record of a neighbour some rows on, and its force sums: the neighbours in the layer
-            // above a ball are a whole layer away in memory, and the hardware prefetcher misses them
-            // (perf annotate).
+            // above a ball are a whole layer away in memory, and the hardware prefetcher misses them.
             const std::size_t ahead_ball = keys[row_at(k - kPrefetchRows)].b;
             const char* ahead = reinterpret_cast<const char*>(kin + ahead_ball);
             __builtin_prefetch(ahead);
@@ -1210,13 +1005,13 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
       // run_rows for live rows, with the record of each row in place of its nine columns. A row that
       // is no contact (a neighbour pair within reach of one, or a contact deleted since the list)
       // is checked for reach from the record and its second ball's, which the lanes read anyway.
-      LiveRecord* rec = live_records_.data();
-      for (std::size_t k = live_first_[a + 1]; k-- > live_first_[a];) {
+      LiveRecord* rec = live_.records();
+      const std::uint32_t* live_first = live_.first();
+      for (std::size_t k = live_first[a + 1]; k-- > live_first[a];) {
         if (far) {
-          // The neighbour's record and sums, as in run_rows (24 rows ahead the same as 16), and the
-          // record 64 rows on (one line a row; 32-128 rows alike, 16 slower). Asked for to be read,
-          // not written (prefetchw), although both lines are written later: 1.02-1.03 x each for the
-          // records and for the sums, in one run (eighteenth session).
+          // The neighbour's record and sums, as in run_rows, and the record 64 rows on (one line a
+          // row). Asked for to be read, not written (prefetchw), although both lines are written
+          // later (docs/performance.md).
           if (k >= kPrefetchRows) {
             const std::size_t ahead_ball = rec[k - kPrefetchRows].b;
             const char* ahead = reinterpret_cast<const char*>(kin + ahead_ball);
@@ -1226,8 +1021,8 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
           }
           if (k >= kPrefetchRecords) __builtin_prefetch(rec + k - kPrefetchRecords);
         } else if (k >= kPrefetchRecords) {
-          // The records alone in the caches' range too: the stream runs down, and the loads of its
-          // lines drew samples there (1.008-1.023 x at 11,200 spheres, four runs; nineteenth session).
+          // The records alone in the caches' range too: the stream runs down, and the hardware
+          // prefetcher follows it poorly.
           __builtin_prefetch(rec + k - kPrefetchRecords);
         }
         const LiveRecord& r = rec[k];
@@ -1241,7 +1036,7 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
           if (!exists && within_reach(ka, b, r.image)) [[unlikely]] {  // a contact again (force_row)
             if (hill.size() > 0) flush(hill);
             add_share(c, force_row(c, dt));
-            load_live_record(k);
+            live_.load_record(k, contacts, row_hill_set_.data());
           }
           continue;
         }
@@ -1249,10 +1044,11 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
         run_rows(k + 1, k, [rec](std::size_t j) -> std::size_t { return rec[j].row; });
       }
     } else if (live) {
-      const std::uint32_t* rows = live_rows_.data();
-      run_rows(live_first_[a + 1], live_first_[a], [rows](std::size_t k) -> std::size_t { return rows[k]; });
+      const std::uint32_t* rows = live_.rows();
+      run_rows(live_.first()[a + 1], live_.first()[a], [rows](std::size_t k) -> std::size_t { return rows[k]; });
     } else {  // every row through force_row (each contact's shear displacement tracked)
-      for (std::size_t c = first_rows_[a + 1]; c-- > first_rows_[a];) add_share(c, force_row(c, dt));
+      const std::vector<std::uint32_t>& first_rows = neighbours_.first_rows();
+      for (std::size_t c = first_rows[a + 1]; c-- > first_rows[a];) add_share(c, force_row(c, dt));
     }
   }
   if (hill.size() > 0) flush(hill);
@@ -1261,8 +1057,8 @@ void Simulation::force_block(std::size_t a0, std::size_t a1, std::size_t range_e
 
 void Simulation::wall_block(std::size_t k0, std::size_t k1, double dt, BlockScratch& scratch, std::size_t& bad_row,
                             std::int64_t& batched_count) {
-  // Wall rows row by row took 12 % of a lab test (perf, C5b hill test): the chain of square roots
-  // and divisions of one contact at a time, as ball-ball rows before the batches.
+  // Existing linear wall contacts through a linear batch: one contact's law at a time is a chain of
+  // dependent square roots and divisions (engine/contact_batch.hpp).
   const bool want_stiffness = settings.auto_timestep || settings.density_scaling;
   const bool batched = !settings.track_shear_displacement;
   using F = ContactBatch;
@@ -1290,7 +1086,7 @@ void Simulation::wall_block(std::size_t k0, std::size_t k1, double dt, BlockScra
     batch.clear();
   };
   for (std::size_t k = k0; k < k1; ++k) {
-    const std::size_t c = wall_rows_[k];
+    const std::size_t c = neighbours_.wall_rows()[k];
     if (!batched || !contacts.exists[c] || contacts.model[c] != ModelKind::Linear) {
       done(c, force_row(c, dt));
       continue;
@@ -1324,349 +1120,166 @@ void Simulation::wall_block(std::size_t k0, std::size_t k1, double dt, BlockScra
   if (batch.size() > 0) flush();
 }
 
-bool Simulation::balance_speeds() {
-  // Each thread's speed over the passes since the split: its work (split_work's units) over its time
-  // in the blocks [s]. The cores of a shared machine run at different speeds (here one of the two
-  // often runs 1.3 x slower than the other, which one changing from run to run), and with equal work
-  // the faster thread waits for the slower at the end of every pass. Shares of the work in
-  // proportion to the speeds, half way from the last shares (the speeds are noisy); a new split only
-  // if a share moved by more than 1 %. Which balls a thread sums changes no result (force_pass).
-  const std::size_t threads = thread_share_.size();
-  if (!thread_shares.empty() || threads < 2 || thread_busy_.size() != threads ||
-      work_start_.size() != threads + 1 || work_prefix_.size() != balls.size() + 1)
-    return false;
-  std::vector<double> speed(threads);
-  double total = 0.0;
-  for (std::size_t t = 0; t < threads; ++t) {
-    const double work = static_cast<double>(work_prefix_[work_start_[t + 1]] - work_prefix_[work_start_[t]]);
-    if (!(thread_busy_[t] > 0.0) || !(work > 0.0)) return false;
-    speed[t] = work / thread_busy_[t];
-    total += speed[t];
-  }
-  // (No share below a tenth of an equal one: a thread with no balls could not be timed again.)
-  const double least = 0.1 / static_cast<double>(threads);
-  std::vector<double> share(threads);
-  double sum = 0.0;
-  for (std::size_t t = 0; t < threads; ++t) {
-    share[t] = std::max(0.5 * thread_share_[t] + 0.5 * speed[t] / total, least);
-    sum += share[t];
-  }
-  bool moved = false;
-  for (std::size_t t = 0; t < threads; ++t) {
-    moved |= std::abs(share[t] / sum - thread_share_[t]) > 0.01;
-    thread_share_[t] = share[t] / sum;
-  }
-  return moved;
-}
-
-void Simulation::split_work(int threads) {
-  // Work of ball i in the pass, in units of a neighbour row that is not a contact, and two for the
-  // ball itself (its record, its half of the force sum). With the live rows: four for each live row
-  // (gather, law and scatter); the list holds these counts already. Without (every row through
-  // force_row): four for each of its rows. And four for each of its wall rows, which its thread runs.
-  // Threads get ranges of equal work, not of equal numbers of balls: rows and contacts per ball vary
-  // across a specimen (denser at the bottom of a bed, none above its surface), and with equal
-  // numbers of balls one thread waited at the end of the pass (a third of its time on an unsettled
-  // bed).
-  const std::size_t n = balls.size();
-  work_start_.assign(static_cast<std::size_t>(threads) + 1, n);
-  work_start_[0] = 0;
-  if (threads <= 1 || n == 0) {
-    // (Equal shares: without them force_pass took every pass for a new split, and made the crossing
-    // floor again each time.)
-    const auto count = static_cast<std::size_t>(std::max(threads, 1));
-    thread_share_.assign(count, 1.0 / static_cast<double>(count));
-    return;
-  }
-  std::vector<std::uint64_t>& prefix = work_prefix_;
-  prefix.resize(n + 1);
-  prefix[0] = 0;
-  const bool live = live_now_ && live_ready_ && live_first_.size() == n + 1;
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::uint64_t rows = live ? live_first_[i + 1] - live_first_[i] : first_rows_[i + 1] - first_rows_[i];
-    prefix[i + 1] = prefix[i] + 2 + 4 * rows + 4 * (wall_rows_start_[i + 1] - wall_rows_start_[i]);
-  }
-  // Thread t's share of the work: given (thread_shares), or in proportion to the threads' speeds
-  // (balance_speeds; equal at first).
-  const auto count = static_cast<std::size_t>(threads);
-  if (thread_shares.size() == count) {
-    const double sum = std::accumulate(thread_shares.begin(), thread_shares.end(), 0.0);
-    thread_share_.resize(count);
-    for (std::size_t t = 0; t < count; ++t)
-      thread_share_[t] = sum > 0.0 ? std::max(thread_shares[t], 0.0) / sum : 1.0 / threads;
-  } else if (thread_share_.size() != count) {
-    thread_share_.assign(count, 1.0 / threads);
-  }
-  double before = 0.0;
-  for (std::size_t t = 1; t < count; ++t) {
-    before += thread_share_[t - 1];
-    const auto target = static_cast<std::uint64_t>(static_cast<double>(prefix[n]) * std::min(before, 1.0));
-    work_start_[t] = static_cast<std::size_t>(std::lower_bound(prefix.begin(), prefix.end(), target) - prefix.begin());
-  }
-}
-
 void Simulation::refresh_live_rows() {
-  // The slack s: the list is made again when any ball has moved more than s since; it holds the
-  // neighbour pairs within proximity + 2 s. A list that lasted fewer than kLiveShort passes doubles
-  // it (fast balls: fewer remakes, more pairs checked), one that lasted more than kLiveLong halves it
-  // (slow balls), between a thousandth and a quarter of the skin. The list changes no result, only
-  // how much the row loop visits; so neither does s.
-  constexpr std::int64_t kLiveShort = 25, kLiveLong = 400;
-  if (live_records_ready_) sync_live_records();  // (made for the old list)
-  const double skin_now = skin();
-  const std::int64_t lasted = live_passes_;
-  if (!(live_slack_ > 0.0) || live_slack_ > 0.25 * skin_now) live_slack_ = 0.002 * skin_now;
-  else if (live_ready_ && lasted < kLiveShort) live_slack_ = std::min(2.0 * live_slack_, 0.25 * skin_now);
-  else if (live_ready_ && lasted > kLiveLong) live_slack_ = std::max(0.5 * live_slack_, 0.001 * skin_now);
-  live_passes_ = 0;
-  const std::size_t n = balls.size();
-  const double proximity = settings.proximity;
-  const double slack = live_slack_;
-  // Each ball-ball row is live if it is a contact, not a hill row, or a hill neighbour pair within
-  // proximity + 2 s (with a margin of 1e-9 of the radii, far above the rounding of the distances and
-  // of the travel). Such a pair was once kept apart, as a near row that sent its ball through all
-  // its rows once it became a contact; as a live row it costs its record, and each new contact no
-  // more than its own row (docs/performance.md, twenty-first session).
-  auto is_live = [&](std::size_t c) -> std::uint8_t {
-    if (contacts.exists[c] || contacts.model[c] != ModelKind::Hill) return 1;
-    const ContactKey& k = contacts.key[c];
-    Vec3 xb = ball_kin_[k.b].position;
-    if (contacts.image[c] != kNoImage) xb += image_shift(contacts.image[c], settings.box);
-    const double radii = ball_kin_[k.a].radius + ball_kin_[k.b].radius;
-    const double reach = (radii + proximity + 2.0 * slack) * (1.0 + 1e-9);
-    return norm2(xb - ball_kin_[k.a].position) > reach * reach ? 0 : 1;
-  };
-  std::vector<std::uint8_t> live(contacts.size(), 0);
-  live_first_.assign(n + 1, 0);
-#pragma omp parallel for schedule(static) if (n > kParallelMin)
-  for (std::size_t a = 0; a < n; ++a) {
-    std::uint32_t count = 0;
-    for (std::size_t c = first_rows_[a]; c < first_rows_[a + 1]; ++c) count += live[c] = is_live(c);
-    live_first_[a + 1] = count;
-  }
-  for (std::size_t a = 0; a < n; ++a) live_first_[a + 1] += live_first_[a];
-  live_rows_.resize(live_first_[n]);
-#pragma omp parallel for schedule(static) if (n > kParallelMin)
-  for (std::size_t a = 0; a < n; ++a) {
-    std::uint32_t l = live_first_[a];
-    for (std::size_t c = first_rows_[a]; c < first_rows_[a + 1]; ++c)
-      if (live[c]) live_rows_[l++] = static_cast<std::uint32_t>(c);
-  }
-  position_at_live_.resize(n);
-  for (std::size_t i = 0; i < n; ++i) position_at_live_[i] = ball_kin_[i].position;
-  live_travel_ = 0.0;
-  live_bound_valid_ = true;
-  live_proximity_ = settings.proximity;
-  live_rows_of_ = contacts.size();
-  live_ready_ = true;
-  ++live_refreshes_;
-}
-
-void Simulation::load_live_record(std::size_t k) {
-  LiveRecord& r = live_records_[k];
-  const std::size_t c = r.row;
-  r.b = contacts.key[c].b;
-  r.hill_set = row_hill_set_[c];
-  r.image = contacts.image[c];
-  r.exists = contacts.exists[c];
-  r.model = contacts.model[c];
-  r.moisture = contacts.moisture[c];
-  r.normal = contacts.normal[c];
-  r.shear = contacts.shear_state[c];
-}
-
-void Simulation::build_live_records() {
-  live_records_.resize(live_rows_.size());
-  const std::size_t n = balls.size();
-#pragma omp parallel for schedule(static) if (n > kParallelMin)
-  for (std::size_t a = 0; a < n; ++a)
-    for (std::size_t k = live_first_[a]; k < live_first_[a + 1]; ++k) {
-      live_records_[k].row = live_rows_[k];
-      load_live_record(k);
-    }
-  live_records_ready_ = true;
-}
-
-void Simulation::write_back(const LiveRecord& r) {
-  if (r.model != ModelKind::Hill) return;  // (other models keep theirs in the columns)
-  contacts.normal[r.row] = r.normal, contacts.shear_state[r.row] = r.shear;
-  contacts.moisture[r.row] = r.moisture;
-}
-
-void Simulation::sync_live_records() {
-  const std::size_t live = live_records_.size();
-#pragma omp parallel for schedule(static) if (live > kParallelMin)
-  for (std::size_t k = 0; k < live; ++k) write_back(live_records_[k]);
-  live_records_ready_ = false;
+  live_.refresh(contacts, ball_kin_.data(), neighbours_.first_rows().data(), balls.size(), settings.proximity,
+                settings.box, skin());
 }
 
 void Simulation::force_pass(double dt) {
   const std::size_t rows = contacts.size();
   const std::size_t n = balls.size();
   // Blocks of balls, each with its own rows (ball-ball rows are sorted by their first ball); each
-  // row writes only its own columns. Each thread takes a range of balls of equal work
-  // (split_work) in blocks of balls_per_block from its start, and runs the blocks from the last
-  // down. Every ball's force is summed in one order whatever the ranges: its ball-ball rows in
-  // descending row order, then its wall rows (first_rows_, force_block, collect_forces). So results
-  // depend neither on the blocks (ContactBatch::pad_lanes) nor on the thread count. The first
-  // failing row is found by a min-reduction, so the outcome does not depend on the thread count.
-  if (ball_sums_.size() != n) ball_sums_.resize(n);
-  sums_current_ = false;  // (until collect_forces has added every share)
-  const std::size_t block = std::max<std::size_t>(1, balls_per_block);
+  // row writes only its own columns. Each thread takes a range of balls of equal work (WorkSplit)
+  // in blocks of balls_per_block from its start, and runs the blocks from the last down
+  // (run_range). Every ball's force is summed in one order whatever the ranges: its ball-ball rows
+  // in descending row order, then its wall rows (NeighbourList::first_rows, force_block,
+  // collect_forces). So results depend neither on the blocks (ContactBatch::pad_lanes) nor on the
+  // thread count. The first failing row is found by a min-reduction, so the outcome does not depend
+  // on the thread count.
+  ball_kin_.begin_sums(n);  // (not current until collect_forces has added every share)
   std::size_t bad_row = rows;
   std::int64_t batched = 0;
-  const bool terms_ready = body_terms_ready_ && ball_kin_.size() == n;
-  if (!terms_ready || hill_sets_stale_ || row_hill_set_.size() != rows) refresh_param_sets();
-  if (ball_kin_.size() != n) drop_records();
-  ball_kin_.resize(n);
-  // What the pair loop reads of each ball, in one record (two cache lines): one memory stream per
-  // neighbourhood instead of one per column. The position, velocity and spin from the columns unless
-  // the records hold them already (advance_records, or an earlier pass in this step); the hill terms
-  // (four divisions per ball) only when the properties may have changed: at a rebuild,
-  // refresh_mappings() or a restore, the moments at which the row-by-row path's mappings are computed
-  // too (real masses, §2.4). (Within a cycle() call nothing changes a radius, but a controller,
-  // and a controller drops the records.)
-  if (!records_current_ || !terms_ready) {
-    const bool copy = !records_current_;
-#pragma omp parallel for schedule(static) if (n > kParallelMin)
-    for (std::size_t i = 0; i < n; ++i) {
-      BallKin& k = ball_kin_[i];
-      if (copy) {
-        k.position = balls.position[i];
-        k.velocity = balls.velocity[i];
-        k.spin = balls.spin[i];
-        k.mass = balls.mass[i];
-        k.inertia = balls.inertia[i];
-      }
-      k.radius = balls.radius[i];
-      if (!terms_ready)
-        k.terms = hill_body_terms(balls.radius[i], balls.young_mod[i], balls.pois_ratio[i], balls.mass[i]);
-    }
-    records_current_ = true;
-  }
-  // The live rows, made again when a ball may have moved more than the slack since they were
-  // (rebuild_if_needed measured it), or the rows, their models or the proximity may have changed. (A
-  // contact made since, in any pass, was a live row: the others were too far apart to touch.) Not
-  // while each contact's shear displacement is tracked: every row then goes through force_row.
-  live_now_ = !settings.track_shear_displacement;
-  if (!terms_ready || live_rows_of_ != rows || !(live_proximity_ == settings.proximity)) live_ready_ = false;
-  if (live_now_ && !(live_ready_ && live_travel_known_ && live_travel_ <= live_slack_)) refresh_live_rows();
-  live_travel_known_ = false;  // (measured again before the next pass)
-  // The live rows through their records on the steps nobody looks at, made when
-  // at least kRecordSteps more steps follow in this cycle() call: making them and writing them back
-  // cost about half a step at 100,800 spheres (calls of 9 steps gave 1.021 x against 1.084 x for calls
-  // of 200), which ≈ 1.08 x a step wins back in about eight steps.
-  constexpr std::int64_t kRecordSteps = 8;
-  const bool records = live_now_ && !write_results_;
-  if (live_records_ready_ && !records) sync_live_records();
-  if (records && !live_records_ready_ && steps_ahead_ >= kRecordSteps) build_live_records();
-  live_record_passes_ += live_records_ready_;
+  prepare_pass();
   std::unique_ptr<std::atomic<bool>[]> crossing_done;  // per thread: its crossing list is final
   std::atomic<bool> late_share{false};
 #pragma omp parallel reduction(min : bad_row) reduction(+ : batched) if (n > kParallelMin)
   {
-    // ≈ 60 kB: on the heap, not the thread's stack. Default-initialised: make_unique would zero it on
-    // every pass (≈ 1 % of the in-cache bed's instructions, callgrind; 1.023 x there without, 6 pairs),
-    // and every lane value a law or the scatter uses is written before it is read.
+    // ≈ 60 kB: on the heap, not the thread's stack. Default-initialised (make_unique would zero it on
+    // every pass): every lane value a law or the scatter uses is written before it is read.
     std::unique_ptr<BlockScratch> scratch(new BlockScratch);
 #pragma omp single
     {
-      // The split is a serial pass over the balls (≈ 2 % of a two-thread step at 100,800 balls) and
-      // moves slowly with the contacts; it changes no result, so it is redone only when the rows or
-      // the thread count changed, every kSplitEvery passes, or when the threads' speeds moved their
-      // shares (balance_speeds, every kSpeedEvery passes).
       const auto threads = static_cast<std::size_t>(omp_get_num_threads());
-      bool resplit = work_start_.size() != threads + 1 || work_start_.back() != n || split_rows_ != rows ||
-                     thread_share_.size() != threads ||
-                     ++split_age_ >= kSplitEvery;
-      if (!resplit && ++speed_age_ >= kSpeedEvery) resplit = balance_speeds();
-      if (resplit) {
-        split_work(omp_get_num_threads());
-        split_rows_ = rows;
-        split_age_ = 0;
-      }
-      if (resplit || speed_age_ >= kSpeedEvery) {  // the speeds measured afresh
-        thread_busy_.assign(threads, 0.0);
-        speed_age_ = 0;
-      }
+      const bool live_split = live_.visited() && live_.covers(n);
+      const std::uint32_t* row_first = live_split ? live_.first() : neighbours_.first_rows().data();
+      const bool resplit =
+          split_.prepare(threads, n, rows, thread_shares, row_first, neighbours_.wall_rows_start().data());
       crossing_.resize(threads);
       if (resplit || crossing_floor_.size() != threads) crossing_floor_.assign(threads, kFloorUnknown);
       crossing_done.reset(new std::atomic<bool>[threads]);
       for (std::size_t u = 0; u < threads; ++u) crossing_done[u].store(false, std::memory_order_relaxed);
     }
-    const auto t = static_cast<std::size_t>(omp_get_thread_num());
-    const std::size_t first = work_start_[t], last = work_start_[t + 1];
-    std::vector<CrossShare>& crossing = crossing_[t];
-    crossing.clear();
-    // One thread needs no timing: its share is the whole.
-    const bool timed = omp_get_num_threads() > 1;
-    const double busy_from = timed ? omp_get_wtime() : 0.0;
-    // The lowest ball of the range with a row into a later range (made once per split: the rows do
-    // not change until the next). Below it the thread adds no crossing share, and from there its list
-    // is final and announced (crossing_done), long before its pass ends: the blocks run from the
-    // last down, and the crossing rows are those of its top layer of balls: only its top row_span_
-    // balls can have one, and the last range has none.
-    if (crossing_floor_[t] == kFloorUnknown) {
-      std::size_t floor = last;
-      if (last < n)
-        for (std::size_t a = last - std::min(last - first, row_span_); a < last && floor == last; ++a)
-          if (first_rows_[a + 1] > first_rows_[a] && contacts.key[first_rows_[a + 1] - 1].b >= last) floor = a;
-      crossing_floor_[t] = floor;
-    }
-    const std::size_t floor = crossing_floor_[t];
-    bool announced = false;
-    std::size_t announced_size = 0;
-    auto announce = [&] {
-      crossing_done[t].store(true, std::memory_order_release);
-      announced = true;
-      announced_size = crossing.size();
-    };
-    if (floor >= last) announce();
-    if (last > first)
-      for (std::size_t a = first + (last - first - 1) / block * block;; a -= block) {
-        force_block(a, std::min(last, a + block), last, dt, *scratch, crossing, bad_row, batched);
-        if (!announced && a <= floor) announce();
-        if (a == first) break;
-      }
-    if (!announced) announce();
-    // (A share added after the list was announced would be a wrong floor: another thread may have read
-    // the list already. Never seen; checked, as it costs nothing.)
-    if (crossing.size() != announced_size) late_share.store(true, std::memory_order_relaxed);
-    // The end of the range's force sums, by the thread itself, in their order (force_pass): the
-    // crossing shares into its balls from the ranges below, the last range's first (each list once
-    // its thread announced it: no wait in practice), then its balls' wall rows in row order
-    // (wall_block: each row's result depends on no other row, nor on the batch it falls into).
-    for (std::size_t u = t; u-- > 0;) {
-      for (int spin = 0; !crossing_done[u].load(std::memory_order_acquire); ++spin)
-        if (spin > 1000) std::this_thread::yield();  // (more threads than cores: let the other run)
-      add_crossing(crossing_[u], first, last);
-    }
-    const std::size_t k0 = wall_rows_start_[first], k1 = wall_rows_start_[last];
-    if (k1 > k0) {
-      wall_block(k0, k1, dt, *scratch, bad_row, batched);
-      add_wall_rows(k0, k1);
-    }
-    if (timed) thread_busy_[t] += omp_get_wtime() - busy_from;  // [s] (balance_speeds)
+    run_range(static_cast<std::size_t>(omp_get_thread_num()), dt, *scratch, crossing_done.get(), late_share, bad_row,
+              batched);
   }
   if (late_share.load()) throw RunError("internal error: a crossing share after its list was final (force_pass)");
   batched_rows_ = batched;
   body_terms_ready_ = true;
-  ++live_passes_;
-  if (bad_row < rows) {
-    const ContactKey& key = contacts.key[bad_row];
-    std::ostringstream msg;
-    msg << "non-finite contact force at step " << steps + 1 << " between ball " << balls.id[key.a] << " and "
-        << (key.kind == ContactKind::BallBall ? "ball " + std::to_string(balls.id[key.b])
-                                              : "wall '" + walls.walls[key.b].name + "'")
-        << " (gap " << contacts.gap[bad_row] << " m): the run is unstable; reduce the time step";
-    throw RunError(msg.str());
-  }
+  live_.count_pass();
+  if (bad_row < rows) throw_bad_row(bad_row);
   collect_forces();
+}
+
+void Simulation::prepare_pass() {
+  // The ball records, the hill parameter sets and the live rows (and their records) the pass reads.
+  const std::size_t rows = contacts.size();
+  const std::size_t n = balls.size();
+  const bool terms_ready = body_terms_ready_ && ball_kin_.size() == n;
+  if (!terms_ready || hill_sets_stale_ || row_hill_set_.size() != rows) refresh_param_sets();
+  if (ball_kin_.size() != n) drop_records();
+  // What the pair loop reads of each ball, in one record (two cache lines): the position, velocity
+  // and spin from the columns unless the records hold them already (advance_records, or an earlier
+  // pass in this step); the hill terms (four divisions per ball) only when the properties may have
+  // changed: at a rebuild, refresh_mappings() or a restore, the moments at which the row-by-row
+  // path's mappings are computed too (real masses, §2.4). (Within a cycle() call nothing but a
+  // controller changes a radius, and a controller drops the records.)
+  if (!ball_kin_.current() || !terms_ready) ball_kin_.fill(balls, !ball_kin_.current(), !terms_ready);
+  // The live rows, made again when a ball may have moved more than the slack since they were
+  // (rebuild_if_needed measured it), or the rows, their models or the proximity may have changed. (A
+  // contact made since, in any pass, was a live row: the others were too far apart to touch.) Not
+  // while each contact's shear displacement is tracked: every row then goes through force_row.
+  live_.set_visited(!settings.track_shear_displacement);
+  if (!terms_ready || !live_.made_for(rows, settings.proximity)) live_.invalidate();
+  if (live_.visited() && !live_.current()) refresh_live_rows();
+  live_.end_pass_measure();
+  // The live rows through their records on the steps nobody looks at, made when at least
+  // kRecordSteps more steps follow in this cycle() call: making them and writing them back costs
+  // about half a step, which the faster steps win back in about eight (docs/performance.md).
+  constexpr std::int64_t kRecordSteps = 8;
+  const bool records = live_.visited() && !write_results_;
+  if (live_.records_ready() && !records) live_.sync_records(contacts);
+  if (records && !live_.records_ready() && steps_ahead_ >= kRecordSteps)
+    live_.build_records(contacts, row_hill_set_.data(), n);
+  live_.count_record_pass();
+}
+
+void Simulation::run_range(std::size_t t, double dt, BlockScratch& scratch, std::atomic<bool>* crossing_done,
+                           std::atomic<bool>& late_share, std::size_t& bad_row, std::int64_t& batched) {
+  // Thread t's range of balls (force_pass), its crossing shares announced to the threads above as
+  // soon as they are final, then the end of its balls' sums.
+  const std::size_t block = std::max<std::size_t>(1, balls_per_block);
+  const std::size_t first = split_.begin(t), last = split_.end(t);
+  std::vector<CrossShare>& crossing = crossing_[t];
+  crossing.clear();
+  // One thread needs no timing: its share is the whole.
+  const bool timed = omp_get_num_threads() > 1;
+  const double busy_from = timed ? omp_get_wtime() : 0.0;
+  // The lowest ball of the range with a row into a later range (made once per split: the rows do
+  // not change until the next). Below it the thread adds no crossing share, and from there its list
+  // is final and announced (crossing_done), long before its pass ends: the blocks run from the
+  // last down, and the crossing rows are those of its top layer of balls: only its top row_span balls
+  // (NeighbourList::row_span) can have one, and the last range has none.
+  if (crossing_floor_[t] == kFloorUnknown) crossing_floor_[t] = crossing_floor(first, last);
+  const std::size_t floor = crossing_floor_[t];
+  bool announced = false;
+  std::size_t announced_size = 0;
+  auto announce = [&] {
+    crossing_done[t].store(true, std::memory_order_release);
+    announced = true;
+    announced_size = crossing.size();
+  };
+  if (floor >= last) announce();
+  if (last > first)
+    for (std::size_t a = first + (last - first - 1) / block * block;; a -= block) {
+      force_block(a, std::min(last, a + block), last, dt, scratch, crossing, bad_row, batched);
+      if (!announced && a <= floor) announce();
+      if (a == first) break;
+    }
+  if (!announced) announce();
+  // (A share added after the list was announced would be a wrong floor: another thread may have read
+  // the list already. Never seen; checked, as it costs nothing.)
+  if (crossing.size() != announced_size) late_share.store(true, std::memory_order_relaxed);
+  // The end of the range's force sums, by the thread itself, in their order (force_pass): the
+  // crossing shares into its balls from the ranges below, the last range's first (each list once
+  // its thread announced it: no wait in practice), then its balls' wall rows in row order
+  // (wall_block: each row's result depends on no other row, nor on the batch it falls into).
+  for (std::size_t u = t; u-- > 0;) {
+    for (int spin = 0; !crossing_done[u].load(std::memory_order_acquire); ++spin)
+      if (spin > 1000) std::this_thread::yield();  // (more threads than cores: let the other run)
+    add_crossing(crossing_[u], first, last);
+  }
+  const std::size_t k0 = neighbours_.wall_rows_start()[first], k1 = neighbours_.wall_rows_start()[last];
+  if (k1 > k0) {
+    wall_block(k0, k1, dt, scratch, bad_row, batched);
+    add_wall_rows(k0, k1);
+  }
+  if (timed) split_.add_busy(t, omp_get_wtime() - busy_from);  // [s]
+}
+
+std::size_t Simulation::crossing_floor(std::size_t first, std::size_t last) const {
+  std::size_t floor = last;
+  if (last < balls.size()) {
+    const std::vector<std::uint32_t>& rows_of = neighbours_.first_rows();
+    for (std::size_t a = last - std::min(last - first, neighbours_.row_span()); a < last && floor == last; ++a)
+      if (rows_of[a + 1] > rows_of[a] && contacts.key[rows_of[a + 1] - 1].b >= last) floor = a;
+  }
+  return floor;
+}
+
+void Simulation::throw_bad_row(std::size_t bad_row) const {
+  // (The gap column is written for a row whose force is not finite: store_row.)
+  const ContactKey& key = contacts.key[bad_row];
+  std::ostringstream msg;
+  msg << "non-finite contact force at step " << steps + 1 << " between ball " << balls.id[key.a] << " and "
+      << (key.kind == ContactKind::BallBall ? "ball " + std::to_string(balls.id[key.b])
+                                            : "wall '" + walls.walls[key.b].name + "'")
+      << " (gap " << contacts.gap[bad_row] << " m): the run is unstable; reduce the time step";
+  throw RunError(msg.str());
 }
 
 void Simulation::add_crossing(const std::vector<CrossShare>& list, std::size_t first, std::size_t last) {
   const bool want_stiffness = settings.auto_timestep || settings.density_scaling;
-  motion::ContactSums* __restrict sums = ball_sums_.data();
+  motion::ContactSums* __restrict sums = ball_kin_.sums();
   for (const CrossShare& s : list)
     if (s.b >= first && s.b < last) {
       sums[s.b].force += motion::load(s.force);
@@ -1678,9 +1291,9 @@ void Simulation::add_crossing(const std::vector<CrossShare>& list, std::size_t f
 
 void Simulation::add_wall_rows(std::size_t k0, std::size_t k1) {
   const bool want_stiffness = settings.auto_timestep || settings.density_scaling;
-  motion::ContactSums* __restrict sums = ball_sums_.data();
+  motion::ContactSums* __restrict sums = ball_kin_.sums();
   for (std::size_t k = k0; k < k1; ++k) {
-    const std::uint32_t c = wall_rows_[k];
+    const std::uint32_t c = neighbours_.wall_rows()[k];
     const std::size_t a = contacts.key[c].a;
     sums[a].force -= motion::load(contacts.force[c]);
     sums[a].moment += motion::load(share_moment_[c]);
@@ -1698,7 +1311,7 @@ void Simulation::collect_forces() {
     w.active_contacts = 0;
   }
   // Each wall row into its wall's sums, in row order.
-  for (std::uint32_t c : wall_rows_) {
+  for (std::uint32_t c : neighbours_.wall_rows()) {
     const ContactKey& k = contacts.key[c];
     if (!contacts.active[c]) continue;
     Wall& w = walls.walls[k.b];
@@ -1711,21 +1324,9 @@ void Simulation::collect_forces() {
   }
   stiffness_ready_ = want_stiffness;
   // The BallStore's columns of the sums on the passes someone may read them after (as the reported
-  // contact columns); the law of motion reads ball_sums_ itself.
-  sums_current_ = true;
-  sum_columns_stale_ = true;
-  if (write_results_) sync_sum_columns();
-}
-
-void Simulation::sync_sum_columns() {
-  if (!sum_columns_stale_) return;
-  const std::size_t n = std::min(balls.size(), ball_sums_.size());
-#pragma omp parallel for schedule(static) if (n > kParallelMin)
-  for (std::size_t i = 0; i < n; ++i) {
-    motion::store(balls.contact_force[i], ball_sums_[i].force);
-    motion::store(balls.contact_moment[i], ball_sums_[i].moment);
-  }
-  sum_columns_stale_ = false;
+  // contact columns); the law of motion reads the sums themselves.
+  ball_kin_.end_sums();
+  if (write_results_) ball_kin_.sync_sum_columns(balls);
 }
 
 void Simulation::add_row_stiffness(std::size_t c, double radius, double& k_tran, double& k_rot) const {
@@ -1743,12 +1344,15 @@ void Simulation::ball_stiffness(std::size_t i, double& k_tran, double& k_rot) co
   // row order, its own rows then those where it is piece 2; then its wall rows), so the result does
   // not depend on which way it was computed (a resumed run takes this way first).
   k_tran = k_rot = 0.0;
-  if (i + 1 >= first_rows_.size()) return;  // a ball added since the last rebuild: no contacts yet
-  for (std::size_t c = first_rows_[i + 1]; c-- > first_rows_[i];) add_row_stiffness(c, balls.radius[i], k_tran, k_rot);
-  for (std::uint32_t k = late_rows_start_[i + 1]; k-- > late_rows_start_[i];)
-    add_row_stiffness(late_rows_[k], balls.radius[i], k_tran, k_rot);
-  for (std::uint32_t k = wall_rows_start_[i]; k < wall_rows_start_[i + 1]; ++k)
-    add_row_stiffness(wall_rows_[k], balls.radius[i], k_tran, k_rot);
+  const NeighbourList& list = neighbours_;
+  const std::vector<std::uint32_t>& first = list.first_rows();
+  if (i + 1 >= first.size()) return;  // a ball added since the last rebuild: no contacts yet
+  const double radius = balls.radius[i];
+  for (std::size_t c = first[i + 1]; c-- > first[i];) add_row_stiffness(c, radius, k_tran, k_rot);
+  for (std::uint32_t k = list.late_rows_start()[i + 1]; k-- > list.late_rows_start()[i];)
+    add_row_stiffness(list.late_rows()[k], radius, k_tran, k_rot);
+  for (std::uint32_t k = list.wall_rows_start()[i]; k < list.wall_rows_start()[i + 1]; ++k)
+    add_row_stiffness(list.wall_rows()[k], radius, k_tran, k_rot);
 }
 
 double Simulation::estimate_timestep() const {
@@ -1800,7 +1404,7 @@ double Simulation::mean_unbalanced_ratio() const {
 
 std::size_t Simulation::make_wet(double suction, double gap) {
   rebuild(std::max(gap, settings.proximity));  // step 1: every pair within the gap has a row
-  rebuild_needed_ = true;                       // back to the normal reach at the next cycle
+  neighbours_.invalidate();                     // back to the normal reach at the next cycle
   std::size_t wet = 0;
   for (std::size_t c = 0; c < contacts.size(); ++c) {
     if (contacts.model[c] != ModelKind::Hill) continue;

@@ -11,6 +11,7 @@
 // Lab-test drivers and the scenario runner use only this public API.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -19,7 +20,11 @@
 #include "hilldem/bodies/ball_store.hpp"
 #include "hilldem/bodies/wall_store.hpp"
 #include "hilldem/contact/contact_store.hpp"
+#include "hilldem/engine/ball_records.hpp"
 #include "hilldem/engine/contact_batch.hpp"
+#include "hilldem/engine/live_rows.hpp"
+#include "hilldem/engine/neighbour_list.hpp"
+#include "hilldem/engine/work_split.hpp"
 #include "hilldem/models/model_table.hpp"
 #include "hilldem/motion/ball_step.hpp"
 #include "hilldem/motion/law_of_motion.hpp"
@@ -114,9 +119,9 @@ class Simulation {
   // How often the live rows were made (the rows the force pass visits: contacts, rows of other models
   // than hill, and the hill neighbour pairs within proximity + 2 s when the list was made; remade when
   // a ball has moved more than the slack s since).
-  std::int64_t live_row_refreshes() const { return live_refreshes_; }
+  std::int64_t live_row_refreshes() const { return live_.refreshes(); }
   // How many force passes ran through the live records.
-  std::int64_t live_record_passes() const { return live_record_passes_; }
+  std::int64_t live_record_passes() const { return live_.record_passes(); }
   // Given shares of the work per thread (one per thread, normalised) instead of those measured from
   // the threads' speeds: for tests, and for cores of known speeds. Results do not depend on them.
   std::vector<double> thread_shares;
@@ -134,19 +139,19 @@ class Simulation {
   void refresh_mappings();
   // Rebuild the neighbour list before the next force evaluation (after bodies were added or moved
   // by hand, or the table changed).
-  void invalidate_neighbours() { rebuild_needed_ = true; }
+  void invalidate_neighbours() { neighbours_.invalidate(); }
   // Number of contacts (rows that exist), and of neighbour-list rebuilds so far.
   std::size_t contact_count() const { return contacts.count_existing(); }
-  std::int64_t rebuilds() const { return rebuilds_; }
+  std::int64_t rebuilds() const { return neighbours_.rebuilds(); }
   // Reorder balls along the cell grid for memory locality. Only before any contact exists.
   void sort_balls_spatially();
   // Forces are recomputed (without any shear increment) before the next cycle: call after moving
   // bodies by hand.
   void invalidate_forces() {
     forces_ready_ = false;
-    sums_current_ = false;
+    ball_kin_.invalidate_sums();
     body_terms_ready_ = false;
-    rebuild_needed_ = true;
+    neighbours_.invalidate();
   }
   // Detect contacts and compute forces at the current state with no motion (Δt = 0 increments).
   void update_forces();
@@ -162,32 +167,28 @@ class Simulation {
   long find_ball_ball(std::int64_t id1, std::int64_t id2) const;
   long find_ball_wall(std::int64_t ball_id, std::size_t wall) const;
   // Candidate pairs that matched no assignment rule at the last detection.
-  std::size_t unassigned_pairs() const { return unassigned_pairs_; }
+  std::size_t unassigned_pairs() const { return neighbours_.unassigned_pairs(); }
 
  private:
   // One cycle; `last`: the last of a cycle() call (its contact results are written).
   void step_once(bool last);
   void step_body(bool last);  // step_once's work (step_once syncs the columns if it throws)
   void rebuild(double reach);
-  void build_row_lists();  // per-ball row lists (CSR) and wall rows from the current rows
+  void build_row_lists();  // the neighbour list's row lists, and the force pass's per-row state
   void rebuild_if_needed();
   void force_pass(double dt);
   // The law of motion on the records, with each ball's travel since the
   // neighbour list (and since the live rows) measured as it moves; write_columns: the BallStore's
   // columns too.
   void advance_records(double dt, const double* inertial_mass, const double* inertial_inertia, bool write_columns);
-  // The columns from the records, if the records are ahead of them (columns_stale_).
-  void sync_ball_columns();
+  // The columns from the records, if the records are ahead of them.
+  void sync_ball_columns() { ball_kin_.sync_columns(balls); }
   // From now on the columns hold the balls' state (synced first): before anything that may read or
   // write them (a controller, a rebuild, the start of a cycle() call).
   void drop_records() {
-    sync_ball_columns();
-    records_current_ = false;
-    applied_known_ = false;
+    ball_kin_.drop(balls);
     skin_known_ = false;
   }
-  // work_start_[t]: the first ball of thread t's range in the force pass, cut at equal work.
-  void split_work(int threads);
   // What a row gives its two bodies (zero when the row is not an active contact).
   struct RowShare {
     Vec3 force;    // on piece 1: −F_c [N] (piece 2 gets F_c = −force)
@@ -198,8 +199,7 @@ class Simulation {
     double k_tran = 0.0, k_shear = 0.0, gap = 0.0;
     bool ok = true;  // false on a non-finite force
     // Zero the forces and moments, and the stiffness terms when they are read, field by field:
-    // `force = moment = Vec3{}` reloads the moment just stored and stalls store forwarding (40 % of
-    // the pair loop's samples in cache; 1.05 × in cache).
+    // `force = moment = Vec3{}` reloads the moment just stored and stalls store forwarding.
     void clear(bool stiffness) {
       force = Vec3{};
       moment = Vec3{};
@@ -244,6 +244,8 @@ class Simulation {
   // The inputs of a batch's lanes (ball-ball rows of force_block), from their rows and the records of
   // their two balls, when the batch runs.
   void fill_lanes(ContactBatch& batch, bool hill) const;
+  void fill_ball_lanes(ContactBatch& batch, bool hill) const;  // what the lanes read of their balls
+  void fill_row_lanes(ContactBatch& batch, bool hill) const;   // and of their rows
   // A batch lane's results as a row outcome (wall_row: a ball-wall lane of wall_block).
   RowOutcome lane_outcome(const ContactBatch& batch, std::size_t lane, bool wall_row) const;
   // store_row for a lane that the lanes marked kQuick (the contact stays, its force is finite):
@@ -259,15 +261,26 @@ class Simulation {
   // bad_row: the lowest row with a non-finite force; batched: + the rows that went through a batch.
   void force_block(std::size_t a0, std::size_t a1, std::size_t range_end, double dt, BlockScratch& scratch,
                    std::vector<CrossShare>& crossing, std::size_t& bad_row, std::int64_t& batched);
-  // The wall rows wall_rows_[k0..k1): existing linear contacts that touch their wall through a linear
-  // batch (the wall's geometry given), the rest row by row (force_row). Each row's results go to its
-  // columns and share_moment_; collect_forces() sums them in row order, so the batches need no order.
+  // Before the force pass's threads start: the ball records, the hill parameter sets, the live rows.
+  void prepare_pass();
+  // Thread t's part of the force pass (force_pass): its blocks, its crossing list (crossing_done[t]
+  // once final; late_share: a share came after), the crossing shares into its balls, its wall rows.
+  void run_range(std::size_t t, double dt, BlockScratch& scratch, std::atomic<bool>* crossing_done,
+                 std::atomic<bool>& late_share, std::size_t& bad_row, std::int64_t& batched);
+  // The lowest ball of balls first..last-1 with a ball-ball row into a later range (last: none).
+  std::size_t crossing_floor(std::size_t first, std::size_t last) const;
+  // RunError for the row with a non-finite force.
+  [[noreturn]] void throw_bad_row(std::size_t bad_row) const;
+  // The wall rows k0..k1 (of NeighbourList::wall_rows): existing linear contacts that touch their
+  // wall through a linear batch (the wall's geometry given), the rest row by row (force_row). Each
+  // row's results go to its columns and share_moment_; collect_forces() sums them in row order, so
+  // the batches need no order.
   void wall_block(std::size_t k0, std::size_t k1, double dt, BlockScratch& scratch, std::size_t& bad_row,
                   std::int64_t& batched);
   // The walls' sums (the balls' sums were ended by the pass's threads: force_pass).
   void collect_forces();
-  // The shares of `list` into balls first..last-1, in list order; the wall rows wall_rows_[k0..k1)
-  // into their balls, in row order (both with their stiffness terms when those are summed).
+  // The shares of `list` into balls first..last-1, in list order; the wall rows k0..k1 into their
+  // balls, in row order (both with their stiffness terms when those are summed).
   void add_crossing(const std::vector<CrossShare>& list, std::size_t first, std::size_t last);
   void add_wall_rows(std::size_t k0, std::size_t k1);
   void compute_mapping(ContactStore& store, std::size_t c) const;
@@ -277,102 +290,44 @@ class Simulation {
   void ball_stiffness(std::size_t i, double& k_tran, double& k_rot) const;
   // Row c's terms of those sums for a ball of the given radius [m] (if the row is an active contact).
   void add_row_stiffness(std::size_t c, double radius, double& k_tran, double& k_rot) const;
-  std::uint64_t piece2_groups(const ContactKey& k) const;
   double skin() const;
-  void wrap_positions();
 
   bool forces_ready_ = false;
   bool write_results_ = true;  // this force pass writes the reported columns (step_once)
   std::int64_t batched_rows_ = 0;
-  bool rebuild_needed_ = true;
-  std::size_t unassigned_pairs_ = 0;
-  std::int64_t rebuilds_ = 0;
-  std::vector<Vec3> position_at_build_;
-  double wall_travel_ = 0.0;                 // bound on any wall point's motion since the rebuild [m]
-  std::vector<std::uint32_t> wall_rows_;     // rows of ball-wall pairs (in row order: by ball)
+  NeighbourList neighbours_;  // the rows, their per-ball lists, when to rebuild (engine/neighbour_list.hpp)
   // The force sum, in one order for any thread count (so any thread count gives the same bits): a
   // ball's ball-ball rows in descending row order, then its wall rows in row order. The pair loop
   // runs over the balls a of a thread's range from its last ball down, through a's ball-ball rows
-  // (rows first_rows_[a]..[a+1]: keys are sorted by kind, then a, then b > a) from the last down,
+  // (NeighbourList::first_rows: keys are sorted by kind, then a, then b > a) from the last down,
   // and adds each row's share to a and to b: b's own rows came before (b > a), and every row (x, b)
   // with x < a comes after. A row whose b lies beyond the thread's range leaves b's share in
   // crossing_, added in descending row order once the thread's own rows are done (by b's thread):
-  // those rows (x below the range of b's thread) come last in b's
-  // order. Then the wall rows, from F_c and share_moment_.
-  std::vector<std::uint32_t> first_rows_;
-  // Per ball, the ball-ball rows where it is piece 2 (in row order; the same sums from the rows
-  // when the pass's sums are not at hand, ball_stiffness), and its wall rows in wall_rows_.
-  std::vector<std::uint32_t> late_rows_start_;
-  std::vector<std::uint32_t> late_rows_;
-  std::vector<std::uint32_t> wall_rows_start_;
+  // those rows (x below the range of b's thread) come last in b's order. Then the wall rows, from
+  // F_c and share_moment_.
   std::vector<Vec3> share_moment_;           // [N m] moment of wall row r on its ball
   std::vector<std::vector<CrossShare>> crossing_;  // per thread of the last force pass
   // Per range of the split, its lowest ball with a ball-ball row into a later range: below it the
   // range's thread adds no crossing share (force_pass). Made once per split and row lists.
   std::vector<std::size_t> crossing_floor_;
-  std::size_t row_span_ = 0;  // the largest b − a of a ball-ball row (build_row_lists)
   static constexpr std::size_t kFloorUnknown = ~std::size_t{0};
   // Per ball, Σ(k̂_n + k̂_s) [N/m] and Σ k̂_s |x_c − x|² [N m] of the last force pass (in the order of
   // the forces), valid while stiffness_ready_.
   std::vector<double> ball_k_tran_, ball_k_rot_;
   bool stiffness_ready_ = false;
-  struct alignas(64) BallKin {
-    Vec3 position;         // [m]
-    double radius = 0.0;   // [m]
-    Vec3 velocity;         // [m/s]
-    Vec3 spin;             // [rad/s]
-    HillBodyTerms terms;   // for the hill mappings
-    double mass = 0.0;     // [kg] and [kg m²]: for the record motion (in the record's last 16 bytes,
-    double inertia = 0.0;  // which the pair loop does not read)
-  };
-  std::vector<BallKin> ball_kin_;             // per ball, what the batched pair loop reads
-  // The records' position, velocity and spin are the balls' state: from the force pass's copy on,
-  // and through the record motion of the steps that follow within one cycle() call. The columns
-  // lag behind while columns_stale_ (only while records_current_).
-  bool records_current_ = false;
-  bool columns_stale_ = false;
-  // Each ball's contact force and moment sums [N], [N m], as the force pass adds them up (one line a
-  // ball, motion::ContactSums). The law of motion reads them while sums_current_ (from the end of a
-  // force pass until a restore or invalidate_forces(); a restored run moves with the columns it
-  // restored). The BallStore's contact_force and contact_moment columns are written from them on
-  // watched passes, and lag behind while sum_columns_stale_ (sync_sum_columns, sync_ball_columns).
-  std::vector<motion::ContactSums> ball_sums_;
-  bool sums_current_ = false;
-  bool sum_columns_stale_ = false;
-  void sync_sum_columns();
-  const motion::ContactSums* contact_sums() const {
-    return sums_current_ && ball_sums_.size() == balls.size() ? ball_sums_.data() : nullptr;
-  }
-  // A bound on the largest travel of a ball since the neighbour list was made [m]: exact after
-  // rebuild_if_needed's pass over the positions (0 at a rebuild), then grown by each record motion
-  // by the step's largest |V| Δt (motion_travel_known_: for this step's rebuild_if_needed). The
-  // record motion so reads no reference position; the exact pass runs only when the bound reaches
-  // half the skin, and a bound within it gives the exact check's answer: the same rebuilds.
-  bool motion_travel_known_ = false;
-  double travel_bound_ = 0.0;
-  // Within one cycle() call nothing but a controller changes the applied loads or the radii, and a
-  // controller drops the records: what the record motion knows of them holds until drop_records().
-  // applied_zero_: every applied force and moment is +0.0 (motion::step_ball<false>).
-  bool applied_known_ = false, applied_zero_ = false;
+  // Per ball, what the pair loop reads (BallKin), the law of motion on it, and the force sums
+  // (engine/ball_records.hpp).
+  BallRecords ball_kin_;
+  // Within one cycle() call nothing but a controller changes the radii, and a controller drops the
+  // records: skin_ holds until drop_records().
   bool skin_known_ = false;
   double skin_ = 0.0;  // [m] skin() while skin_known_
-  std::vector<std::size_t> work_start_;        // threads' ranges of balls in the force pass (split_work)
-  std::vector<std::uint64_t> work_prefix_;     // split_work's running sum of work per ball
-  std::size_t split_rows_ = 0;                 // rows when the split was made
-  int split_age_ = 0;                          // force passes since
-  static constexpr int kSplitEvery = 50;
-  // Threads' shares of the work (split_work), and their time in the blocks since the split [s]
-  // (balance_speeds, looked at every kSpeedEvery passes).
-  std::vector<double> thread_share_;
-  std::vector<double> thread_busy_;
-  static constexpr int kSpeedEvery = 10;
-  int speed_age_ = 0;  // force passes since the speeds were measured afresh
-  bool balance_speeds();  // true: the shares moved, split again
+  WorkSplit split_;  // the threads' ranges of balls in the force pass
   bool body_terms_ready_ = false;            // ball_kin_[i].terms are up to date (see force_pass)
   // The hill parameters the batched pass reads, by set: row c's are hill_sets_[row_hill_set_[c]], the
   // distinct parameters of the rows and the rules (a few: the rules', and what make_wet and stages
-  // gave). A 4-byte index per row instead of the 24-byte parameters: 1.04 x at 100,800 spheres with
-  // none read at all. Made from contacts.hill_params (which stays the record) whenever the mappings
+  // gave): a 4-byte index per row instead of the 24-byte parameters, for the pair loop's memory
+  // traffic. Made from contacts.hill_params (which stays the record) whenever the mappings
   // are (refresh_param_sets: at a rebuild, refresh_mappings(), a restore); create_contact() sets its
   // row's, and flags the sets stale if its rule's parameters are not the set made for the rule.
   std::vector<HillParams> hill_sets_;
@@ -381,52 +336,10 @@ class Simulation {
   bool hill_sets_stale_ = true;  // (set by create_contact from the pass's threads: std::atomic_ref)
   void refresh_param_sets();
   std::vector<double> scaled_mass_, scaled_inertia_;  // density scaling [kg], [kg m²]
-  // The live rows: per ball (live_first_, as first_rows_), in row order, its
-  // ball-ball rows that were live when the list was made (refresh_live_rows), at the positions
-  // position_at_live_ [m]: contacts, rows of other models, and hill neighbour pairs within
-  // proximity + 2 live_slack_ [m]. While no ball has moved more than live_slack_ since, a pair not on
-  // the list is still beyond proximity, so new contacts come only from live rows.
-  std::vector<std::uint32_t> live_rows_;
-  std::vector<std::uint32_t> live_first_;
-  std::vector<Vec3> position_at_live_;
-  double live_slack_ = 0.0;
-  std::size_t live_rows_of_ = 0;   // rows when the list was made
-  double live_proximity_ = 0.0;    // [m] the proximity then
-  std::int64_t live_passes_ = 0;   // force passes since
-  std::int64_t live_refreshes_ = 0;
-  bool live_ready_ = false;
-  bool live_now_ = false;          // this force pass visits the live rows
-  // [m] the largest travel of a ball since the list, or a bound on it carried from step to step
-  // (valid while live_bound_valid_): exact where it was last measured ball by ball (rebuild_if_needed,
-  // advance_records), then grown by each record motion by its largest |V| Δt (live_growth_, the last
-  // step's), as travel_bound_ is. advance_records measures ball by ball only when the bound, grown by
-  // a few more such steps, would pass the slack.
-  double live_travel_ = 0.0, live_growth_ = 0.0;
-  bool live_bound_valid_ = false;
-  bool live_travel_known_ = false; // measured for this pass
+  // The rows the force pass visits, and their records (engine/live_rows.hpp).
+  LiveRows live_;
   void refresh_live_rows();
-  // The live rows' records, in live-row order (live_rows_), one cache line each:
-  // what the row loop and the lanes read and write of a row. n̂_c, F^h_s and M are those of hill rows
-  // only (other models keep theirs in the columns, and their `exists` is read there too).
-  struct alignas(64) LiveRecord {
-    std::uint32_t row = 0, b = 0;  // the row; its second ball
-    std::uint32_t hill_set = 0;    // row_hill_set_
-    ImageCode image = kNoImage;
-    std::uint8_t exists = 0;
-    ModelKind model = ModelKind::Hill;
-    Moisture moisture = Moisture::Dry;
-    Vec3 normal;  // n̂_c of the last step
-    Vec3 shear;   // F^h_s [N]
-  };
-  static_assert(sizeof(LiveRecord) == 64);
-  std::vector<LiveRecord> live_records_;
-  bool live_records_ready_ = false;   // the records hold the live hill rows' history
-  std::int64_t steps_ahead_ = 0;      // steps of the current cycle() call after this one
-  std::int64_t live_record_passes_ = 0;
-  void build_live_records();
-  void load_live_record(std::size_t k);  // record k from the columns
-  void sync_live_records();              // the history back into the columns; the records dropped
-  void write_back(const LiveRecord& r);  // one record's history (hill rows) into the columns
+  std::int64_t steps_ahead_ = 0;  // steps of the current cycle() call after this one
 };
 
 }  // namespace hilldem
