@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <numbers>
 #include <random>
 
@@ -68,10 +69,9 @@ HillState state(const Vec3& shear_hm, Moisture m = Moisture::Dry) {
 
 // The production law at both of its widths: hill_law<lanes::Pack>, as the batched force pass runs it,
 // with the contact in every lane of a Pack (lane j at the gap g_c + j·1e-6 m), and hill_force, its
-// one-contact form (hill_law<double>), at each lane's gap. The two agree to rounding (the compiler
-// may fuse other multiply-adds in vector code) and in every flag. Returns lane 0 (the gap g_c) as a
-// HillResult: every hand value below is checked on the batched width, and the one-contact form
-// within rounding of it.
+// one-contact form (hill_law<double>), at each lane's gap. The two agree bit for bit and in every
+// flag. Returns lane 0 (the gap g_c) as a HillResult: every hand value below is checked on both
+// widths.
 HillResult hill_force_both_widths(const HillParams& p, const HillMapping& m, const ContactKinematics& k,
                                   const HillState& previous) {
   using lanes::Pack;
@@ -97,8 +97,8 @@ HillResult hill_force_both_widths(const HillParams& p, const HillMapping& m, con
                o.ruptured[j] != 0 ? Moisture::Ruptured : previous.moisture};
     return r;
   };
-  // (Within 1e-13 relative, or 1e-9 N where a component is a near-cancellation of two terms.)
-  auto near = [](double a, double b) { return std::abs(a - b) <= 1e-13 * std::max(std::abs(a), std::abs(b)) + 1e-9; };
+  // Bit for bit: the same operations in the same order, no multiply-add fused (CMakeLists.txt).
+  auto near = [](double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; };
   for (std::size_t j = 0; j < lanes::kWidth; ++j) {
     ContactKinematics kj = k;
     kj.gap = gaps[j];

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <numbers>
 
 #include "hilldem/models/lanes.hpp"
@@ -44,7 +45,7 @@ LinearState state(const Vec3& shear) {
 }
 
 // The production law at both of its widths (as test_hill.cpp): linear_law<lanes::Pack>, lane j at
-// the gap g_c + j·1e-6 m, against linear_force (linear_law<double>) at each lane's gap, to rounding;
+// the gap g_c + j·1e-6 m, against linear_force (linear_law<double>) at each lane's gap, bit for bit;
 // returns lane 0.
 LinearResult linear_force_both_widths(const LinearParams& p, const LinearMapping& m, const ContactKinematics& k,
                                       const LinearState& previous) {
@@ -65,7 +66,8 @@ LinearResult linear_force_both_widths(const LinearParams& p, const LinearMapping
     r.state.shear_force = r.shear_force;
     return r;
   };
-  auto near = [](double a, double b) { return std::abs(a - b) <= 1e-13 * std::max(std::abs(a), std::abs(b)) + 1e-9; };
+  // Bit for bit: the same operations in the same order, no multiply-add fused (CMakeLists.txt).
+  auto near = [](double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; };
   for (std::size_t j = 0; j < lanes::kWidth; ++j) {
     ContactKinematics kj = k;
     kj.gap = gaps[j];
