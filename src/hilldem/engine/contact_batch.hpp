@@ -75,7 +75,7 @@ class ContactBatch {
   // periodic image of ball 2: the force pass fills the lanes' ball fields (kDx..kWbz, and the hill
   // terms kIr..kCs) from the balls' records when the batch is run (Simulation::fill_lanes), not row by
   // row. Only when !full().
-  // `slot`: the row's live record (Simulation::use_live_records), whose history the lane reads and
+  // `slot`: the row's live record (engine/live_rows.hpp), whose history the lane reads and
   // writes instead of the row columns; kNoSlot: the columns.
   void add_if(bool keep, std::uint32_t row, std::uint32_t ball1, std::uint32_t ball2, std::uint8_t image,
               std::uint32_t slot = kNoSlot) {

@@ -515,9 +515,8 @@ HILLDEM_INLINE void Simulation::store_row(std::size_t c, const RowOutcome& out, 
   }
   // Force on piece 2 is F_c, on piece 1 −F_c (spec conventions). The contact point lies on the normal
   // at R + g/2 from either centre, so the moment on either ball is −(R + g/2) n̂ × F_c.
-  // (The share is written where it belongs, field by field: built on the stack and copied, its
-  // 32-byte reloads of the fields just stored stalled store forwarding; perf annotate put 11 % of the
-  // in-cache bench on that copy, and writing in place was 1.03 × overall.)
+  // (The share is written where it belongs, field by field: a share built on the stack and copied
+  // reloads fields just stored, which stalls store forwarding.)
   const ContactMoments<double> m =
       contact_moments(lanes::v3(out.normal), out.gap, out.r1, out.r2, lanes::v3(out.force));
   share.force = -out.force;
