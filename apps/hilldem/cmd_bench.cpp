@@ -27,6 +27,9 @@ Command add_bench_command(CLI::App& app) {
                         std::to_string(Simulation::kDefaultBallsPerBlock) +
                         "); a tuning knob, results do not depend on it")
       ->check(CLI::Range(0, 1000000));
+  bench->add_flag("--digest", o->digest,
+                  "also print the state digest after the timed steps (the same for any thread count and block "
+                  "size; serialises the whole state once)");
   bench->add_flag("--memory", *memory,
                   "instead of timing the bed: the memory bandwidth of one core in GB/s (STREAM copy and triad, "
                   "the triad's real traffic with write-allocate, and a read-modify-write update; 3 x 256 MiB), "

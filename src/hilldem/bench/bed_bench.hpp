@@ -18,7 +18,10 @@ struct BedBenchOptions {
   std::int64_t warmup = 200;  // untimed steps
   std::int64_t steps = 1000;  // timed steps
   int threads = 0;            // 0 = OpenMP default
-  std::size_t block = 0;      // balls per block of the force pass (0: the engine's default); tuning only
+  std::size_t block = 0;
+  // Also the state digest after the timed steps (io/state_io.hpp): it serialises the whole state,
+  // ≈ 2.4 kB a ball in memory, and is for checking bits (thread counts, builds), not for timing.
+  bool digest = false;      // balls per block of the force pass (0: the engine's default); tuning only
 };
 
 struct BedBenchResult {
@@ -30,8 +33,8 @@ struct BedBenchResult {
   int threads = 1;
   std::int64_t rebuilds = 0;           // neighbour-list rebuilds during the timed steps
   std::string line() const;            // one machine-readable line
-  // The state digest after the timed steps (io/state_io.hpp): the same for any thread count and
-  // block size, and for any build of one source.
+  // The state digest after the timed steps, when asked for (BedBenchOptions::digest): the same for any
+  // thread count and block size, and for a plain and a profile-guided build of one source.
   std::string digest;
 };
 
