@@ -5,9 +5,11 @@
 // Genesis.* tests pack it from the cloud themselves.
 #pragma once
 
+#include <filesystem>
 #include <string>
 
 #include "hilldem/labtests/specimen_io.hpp"
+#include "hilldem/labtests/study.hpp"
 
 namespace hilldem::testing {
 
@@ -23,6 +25,19 @@ inline GenesisSpec mini_spec() {
 inline const Specimen& mini_packed() {
   static const Specimen s = load_packed_specimen(std::string(HILLDEM_SOURCE_DIR) + "/tests/data/labtests/mini_packed.csv");
   return s;
+}
+
+// A study of the miniature specimen saved into a fresh folder `dir` (its output in dir/out); the
+// caller sets the test.
+inline StudySettings mini_study_from_saved(const std::filesystem::path& dir) {
+  std::filesystem::remove_all(dir);
+  const std::string file = (dir / "mini_packed.csv").string();
+  save_packed_specimen(mini_packed(), mini_spec().packing, file);
+  StudySettings st;
+  st.genesis = mini_spec();
+  st.specimen_file = file;
+  st.output_dir = (dir / "out").string();
+  return st;
 }
 
 }  // namespace hilldem::testing

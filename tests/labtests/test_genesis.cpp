@@ -183,13 +183,7 @@ TEST(Study, EachMaterialIsPackedWithItsOwnModelUnlessPackLinear) {
 // wall before the test, and the test holds σ_c.
 TEST(Study, ConfinementApartFromThePackingPressure) {
   const auto dir = std::filesystem::temp_directory_path() / "hilldem_labtests_confinement";
-  std::filesystem::remove_all(dir);
-  const std::string file = (dir / "mini_packed.csv").string();
-  save_packed_specimen(testing::mini_packed(), testing::mini_spec().packing, file);
-  StudySettings st;
-  st.genesis = testing::mini_spec();
-  st.specimen_file = file;
-  st.output_dir = (dir / "out").string();
+  StudySettings st = testing::mini_study_from_saved(dir);
   st.jobs = 1;
   st.triaxial.cycle_strains = {2e-4};
   st.triaxial.final_strain = 4e-4;

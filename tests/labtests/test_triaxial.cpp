@@ -287,13 +287,7 @@ TEST(SpecimenFile, SavedPackedSpecimenReloadsToTheSameState) {
 // A study of the miniature specimen, saved into a fresh folder `dir`: one cycle at 0.02 %, then on to
 // final_strain [-].
 StudySettings mini_study(const std::filesystem::path& dir, double final_strain) {
-  std::filesystem::remove_all(dir);
-  const std::string file = (dir / "mini_packed.csv").string();
-  save_packed_specimen(testing::mini_packed(), testing::mini_spec().packing, file);
-  StudySettings st;
-  st.genesis = testing::mini_spec();
-  st.specimen_file = file;
-  st.output_dir = (dir / "out").string();
+  StudySettings st = testing::mini_study_from_saved(dir);
   st.triaxial = mini_test();
   st.triaxial.cycle_strains = {2e-4};
   st.triaxial.final_strain = final_strain;

@@ -75,7 +75,7 @@ HillState state(const Vec3& shear_hm, Moisture m = Moisture::Dry) {
 HillResult hill_force_both_widths(const HillParams& p, const HillMapping& m, const ContactKinematics& k,
                                   const HillState& previous) {
   using lanes::Pack;
-  auto pack3 = [](const Vec3& v) { return lanes::V3<Pack>{lanes::splat<Pack>(v.x), lanes::splat<Pack>(v.y), lanes::splat<Pack>(v.z)}; };
+  const auto pack3 = lanes::splat3<Pack>;
   Pack gaps;
   for (std::size_t j = 0; j < lanes::kWidth; ++j) gaps[j] = k.gap + static_cast<double>(j) * 1e-6;
   const Vec3 shear_rate = k.shear_rate();

@@ -50,7 +50,7 @@ LinearState state(const Vec3& shear) {
 LinearResult linear_force_both_widths(const LinearParams& p, const LinearMapping& m, const ContactKinematics& k,
                                       const LinearState& previous) {
   using lanes::Pack;
-  auto pack3 = [](const Vec3& v) { return lanes::V3<Pack>{lanes::splat<Pack>(v.x), lanes::splat<Pack>(v.y), lanes::splat<Pack>(v.z)}; };
+  const auto pack3 = lanes::splat3<Pack>;
   Pack gaps;
   for (std::size_t j = 0; j < lanes::kWidth; ++j) gaps[j] = k.gap + static_cast<double>(j) * 1e-6;
   const LinearOutput<Pack> o =

@@ -109,6 +109,8 @@ template <class R> HILLDEM_INLINE V3<R> select(Mask<R> m, const V3<R>& a, const 
 }
 
 HILLDEM_INLINE V3<double> v3(const Vec3& v) { return {v.x, v.y, v.z}; }
+// v in every lane.
+template <class R> HILLDEM_INLINE V3<R> splat3(const Vec3& v) { return {splat<R>(v.x), splat<R>(v.y), splat<R>(v.z)}; }
 HILLDEM_INLINE Vec3 vec3(const V3<double>& v) { return {v.x, v.y, v.z}; }
 // Three lane columns from `x`, `y`, `z` at lane i (a whole Pack from there).
 HILLDEM_INLINE V3<Pack> load3(const double* x, const double* y, const double* z, std::size_t i) {
