@@ -71,9 +71,9 @@ class ContactBatch {
   }
   // A ball-ball lane for row `row`, kept only if `keep`: the slot after the last lane is written either
   // way and becomes a lane only for a row that is a contact, so that the row loop needs no branch on
-  // it (Simulation::force_block). The row's two balls (the scatter adds to their sums) and the
+  // it (ForcePass::block_rows). The row's two balls (the scatter adds to their sums) and the
   // periodic image of ball 2: the force pass fills the lanes' ball fields (kDx..kWbz, and the hill
-  // terms kIr..kCs) from the balls' records when the batch is run (Simulation::fill_lanes), not row by
+  // terms kIr..kCs) from the balls' records when the batch is run (gather_lanes, engine/lane_gather.hpp), not row by
   // row. Only when !full().
   // `slot`: the row's live record (engine/live_rows.hpp), whose history the lane reads and
   // writes instead of the row columns; kNoSlot: the columns.

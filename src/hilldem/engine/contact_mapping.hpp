@@ -1,5 +1,5 @@
-// A contact's mapping (model parameters and body properties -> the law's constants) and its
-// creation by proximity: shared by the neighbour list's rebuild, make_wet and the force pass.
+// A contact's creation by proximity (its rule's properties, then its mapping: model_dispatch.hpp):
+// shared by make_wet and the force pass.
 #pragma once
 
 #include <cstddef>
@@ -11,10 +11,6 @@
 #include "hilldem/models/model_table.hpp"
 
 namespace hilldem {
-
-// Row c's mapping from its parameters and its bodies' properties (hill: spec §2.4, real masses;
-// linear and rrlinear: the springs).
-void compute_mapping(const BallStore& balls, ContactStore& store, std::size_t c);
 
 // Row c becomes a contact (created by proximity) with normal n̂_c and its assignment rule's
 // properties. Safe from the force pass's threads (each row is written by one thread).

@@ -4,6 +4,7 @@
 
 #include "hilldem/engine/force_pass.hpp"
 #include "hilldem/engine/lane_gather.hpp"
+#include "hilldem/engine/model_dispatch.hpp"
 #include "hilldem/models/lanes.hpp"
 
 namespace hilldem {
@@ -255,10 +256,10 @@ HILLDEM_INLINE void ForcePass::block_rows(Block& blk, std::size_t a, std::size_t
     // A neighbour pair beyond reach gives nothing to either ball.
     if (!exists && !pair_within_reach(ka, blk.kin[b], contacts.image[c], blk.box, blk.proximity)) continue;
     ContactBatch* batch = nullptr;  // the model's batch (exhaustive: -Werror=switch)
-    switch (contacts.model[c]) {
-      case ModelKind::Hill: batch = &hill; break;
-      case ModelKind::Linear: batch = &linear; break;
-      case ModelKind::RrLinear: break;  // (row by row: no batch)
+    switch (batch_of(contacts.model[c])) {
+      case BatchKind::Hill: batch = &hill; break;
+      case BatchKind::Linear: batch = &linear; break;
+      case BatchKind::None: break;  // (row by row)
     }
     if (!exists || batch == nullptr) {  // a new contact, or a model without a batch: row by row
       if (hill.size() > 0) flush(blk, hill);

@@ -11,6 +11,7 @@
 
 #include "hilldem/core/error.hpp"
 #include "hilldem/engine/contact_mapping.hpp"
+#include "hilldem/engine/model_dispatch.hpp"
 #include "hilldem/models/contact_kinematics.hpp"
 #include "hilldem/models/hill.hpp"
 #include "hilldem/models/linear.hpp"
@@ -193,7 +194,7 @@ void ForcePass::collect_forces() {
     w.force += contacts.force[c];
     w.moment += cross(point - w.rotation_center, contacts.force[c]) + contacts.moment_state[c];  // (+ M_c: rrlinear)
     w.normal_force += dot(contacts.force[c], contacts.normal[c]);
-    w.normal_stiffness += contacts.model[c] == ModelKind::Hill ? contacts.k_tran[c] : contacts.linear_map[c].kn;
+    w.normal_stiffness += wall_normal_stiffness(contacts, c);
     ++w.active_contacts;
   }
   w_.stiffness->ready = want_stiffness();
@@ -267,41 +268,10 @@ RowShare ForcePass::force_row(std::size_t c, double dt) {
   const double mean_spin = 0.5 * dot(rec[a].spin + spin2, normal);  // ½(ω1 + ω2)·n̂ [rad/s] (§1.3)
   const Vec3 carried = carry_into_plane(contacts.shear_state[c], contacts.normal[c], normal, mean_spin, dt);
   out.moisture = contacts.moisture[c];
-  StiffnessEstimate stiff;
-  // (Exhaustive: a model without a case here does not compile, -Werror=switch.)
-  switch (contacts.model[c]) {
-    case ModelKind::Hill: {
-      const HillResult r = hill_force(contacts.hill_params[c], contacts.hill_map[c], kin, HillState{carried, out.moisture});
-      out.shear = r.state.shear_hm;
-      out.moisture = r.state.moisture;
-      out.force = r.force, out.normal_force = r.surface_normal, out.moisture_force = r.moisture_force;
-      out.trial_shear = r.trial_shear, out.active = r.active;
-      if (out.active && want_stiffness) stiff = hill_timestep_stiffness(contacts.hill_params[c], contacts.hill_map[c], gap);
-      break;
-    }
-    case ModelKind::Linear: {
-      const LinearResult r = linear_force(contacts.linear_params[c], contacts.linear_map[c], kin, LinearState{carried});
-      out.shear = r.state.shear_force;
-      out.force = r.force, out.normal_force = r.normal_force, out.trial_shear = r.trial_shear, out.active = r.active;
-      if (out.active) stiff = {contacts.linear_map[c].kn, contacts.linear_map[c].ks};
-      break;
-    }
-    case ModelKind::RrLinear: {
-      const Vec3 moment = carry_into_plane(contacts.moment_state[c], contacts.normal[c], normal, mean_spin, dt);
-      const RrLinearResult r =
-          rrlinear_force(contacts.linear_params[c], contacts.linear_map[c], kin, RrLinearState{carried, moment},
-                         spin2 - rec[a].spin, rrlinear_radius(r1, ball2 ? rad[key.b] : 0.0));
-      out.shear = r.linear.state.shear_force;
-      out.force = r.linear.force, out.normal_force = r.linear.normal_force, out.trial_shear = r.linear.trial_shear;
-      out.active = r.linear.active;
-      out.moment = r.moment;
-      out.wall_row = !ball2;
-      if (out.active) stiff = {contacts.linear_map[c].kn, contacts.linear_map[c].ks};
-      break;
-    }
-  }
-  out.k_tran = stiff.kn + stiff.ks;
-  out.k_shear = stiff.ks;
+  run_row_law(contacts, c,
+              RowLawInput{kin, carried, mean_spin, spin2 - rec[a].spin, r1, ball2 ? rad[key.b] : 0.0, !ball2,
+                          want_stiffness},
+              out);
   if (!out.active) out.force = Vec3{};
   // Accumulated shear displacement (reported, not used by the laws): rotated with the plane (and
   // cleared again by store_row if the contact is deleted).
@@ -354,7 +324,7 @@ void ForcePass::wall_block(std::size_t k0, std::size_t k1, BlockScratch& scratch
   };
   for (std::size_t k = k0; k < k1; ++k) {
     const std::size_t c = w_.neighbours->wall_rows()[k];
-    if (!batched || !contacts.exists[c] || contacts.model[c] != ModelKind::Linear) {
+    if (!batched || !contacts.exists[c] || batch_of(contacts.model[c]) != BatchKind::Linear) {
       done(c, force_row(c, dt));
       continue;
     }

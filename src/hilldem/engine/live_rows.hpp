@@ -29,7 +29,7 @@ namespace hilldem {
 // rows only (other models keep theirs in the columns, and their `exists` is read there too).
 struct alignas(64) LiveRecord {
   std::uint32_t row = 0, b = 0;  // the row; its second ball
-  std::uint32_t hill_set = 0;    // the row's hill parameter set (Simulation::row_hill_set_)
+  std::uint32_t hill_set = 0;    // the row's hill parameter set (HillParamSets::row_sets)
   ImageCode image = kNoImage;
   std::uint8_t exists = 0;
   ModelKind model = ModelKind::Hill;

@@ -29,7 +29,7 @@ namespace hilldem {
 
 class NeighbourList {
  public:
-  // Computes a new row's mapping from its parameters (Simulation::compute_mapping).
+  // Computes a new row's mapping from its parameters (compute_mapping, engine/model_dispatch.hpp).
   using MapRow = std::function<void(ContactStore&, std::size_t)>;
 
   // Make the rows for the current positions: every ball-ball pair within `reach` [m] (proximity +

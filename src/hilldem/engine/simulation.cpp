@@ -10,6 +10,7 @@
 
 #include "hilldem/core/error.hpp"
 #include "hilldem/engine/contact_mapping.hpp"
+#include "hilldem/engine/model_dispatch.hpp"
 #include "hilldem/engine/thread_budget.hpp"
 #include "hilldem/motion/ball_step.hpp"
 
