@@ -3,6 +3,7 @@
 // checkpoints.
 #include <fmt/format.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -75,14 +76,17 @@ std::int64_t run_chunked(py::object self, PySimulation& ps, const char* what, st
   return done;
 }
 
-std::optional<Progress> make_progress(bool on, const char* type, std::int64_t steps, double ratio, std::int64_t max_steps) {
+// Progress on stderr (io/progress.hpp), a line every `seconds` [s] (0: none; in place on a terminal).
+std::optional<Progress> make_progress(double seconds, const char* type, std::int64_t steps, double ratio, std::int64_t max_steps) {
   std::optional<Progress> p;
-  if (!on) return p;
-  p.emplace(std::cerr, ProgressMode::Auto, ::isatty(STDERR_FILENO) == 1, 2.0);
+  if (!(seconds >= 0.0) || !std::isfinite(seconds))
+    throw InputError(fmt::format("{}: progress must be the seconds between progress lines, >= 0 (0: none); got {}", type, seconds));
+  if (seconds == 0.0) return p;
+  p.emplace(std::cerr, ProgressMode::Auto, ::isatty(STDERR_FILENO) == 1, seconds);
   ProgressStage st;
   st.index = st.count = 1;
   st.type = type;
-  st.name = "python";
+  st.name = "Simulation";
   st.total_steps = steps;
   st.target_ratio = ratio;
   st.max_steps = max_steps;
@@ -97,7 +101,7 @@ void check_every(const char* what, const py::object& callback, std::int64_t ever
     throw InputError(std::string(what) + ": callback must be callable as callback(sim)");
 }
 
-std::int64_t cycle(py::object self, std::int64_t n, const py::object& callback, std::int64_t every, bool progress) {
+std::int64_t cycle(py::object self, std::int64_t n, const py::object& callback, std::int64_t every, double progress) {
   PySimulation& ps = self.cast<PySimulation&>();
   require_count("cycle", "n", n, 0);
   check_every("cycle", callback, every);
@@ -110,7 +114,7 @@ std::int64_t cycle(py::object self, std::int64_t n, const py::object& callback, 
 }
 
 std::int64_t solve(py::object self, double ratio, std::int64_t max_steps, const py::object& callback, std::int64_t every,
-                   bool progress) {
+                   double progress) {
   PySimulation& ps = self.cast<PySimulation&>();
   if (!(ratio > 0.0) || !std::isfinite(ratio))
     throw InputError(fmt::format("solve: ratio must be a finite number in (0, inf) [-]; got {}", ratio));
@@ -142,20 +146,20 @@ PySimulation from_checkpoint(const std::string& path) {
   return PySimulation(std::move(sc));
 }
 
-void save_checkpoint(PySimulation& ps, const std::string& path) {
+void save_checkpoint(PySimulation& ps, const std::filesystem::path& path) {
   CheckpointWriter w;
   write_simulation(w, ps.sim());
-  w.write_file(path);
+  w.write_file(path.string());
 }
 
 // The scenario's stages (run_scenario), with its histories and probes; files only into output_dir.
-py::dict run_stages(PySimulation& ps, const std::string& output_dir, bool quiet) {
+py::dict run_stages(PySimulation& ps, const std::optional<std::filesystem::path>& output_dir, bool quiet) {
   ps.check_usable("run_stages");
   ps.check_idle("run_stages");
   RunOptions opt;
   opt.quiet = quiet;
-  opt.output_dir = output_dir;
-  opt.write_files = !output_dir.empty();
+  opt.output_dir = output_dir ? output_dir->string() : "";
+  opt.write_files = output_dir.has_value();
   opt.progress = quiet ? ProgressMode::Off : ProgressMode::Auto;
   std::ostringstream log;
   RunResult res;
@@ -222,13 +226,14 @@ hilldem.load_checkpoint(path). Units are SI throughout (docs/python.md).)");
       .def_static("_from_checkpoint", &from_checkpoint, py::arg("path"),
                   "The engine state saved in a checkpoint (by save_checkpoint or the CLI), ready to cycle on.")
       .def("cycle", &cycle, py::arg("n"), py::arg("callback") = py::none(), py::arg("every") = 0,
-           py::arg("progress") = false,
+           py::arg("progress") = 0.0,
            R"(Run n cycles; returns the cycles run. callback(sim) runs after every `every` cycles
-(returning False stops the run there); progress=True prints progress lines on stderr. The GIL is
+(returning False stops the run there); progress: seconds between progress lines on stderr (0: none;
+True: every second). The GIL is
 released while C++ cycles; Ctrl-C raises KeyboardInterrupt between chunks of cycles, the
 simulation left at a cycle boundary (sim.steps says which).)")
       .def("solve", &solve, py::arg("ratio"), py::arg("max_steps"), py::arg("callback") = py::none(),
-           py::arg("every") = 0, py::arg("progress") = false,
+           py::arg("every") = 0, py::arg("progress") = 0.0,
            R"(Cycle (at least once) until the mean unbalanced-force ratio [-] is <= ratio; returns the
 cycles used. RunError if max_steps pass first. callback, every, progress: as cycle().)")
       .def("update_forces", [](PySimulation& ps) {
@@ -253,11 +258,11 @@ their hill contacts, each made wet. Returns the number of wet contacts.)")
              return ps.sim().make_dry();
            },
            "Dry every hill contact; returns how many were wet.")
-      .def("run_stages", &run_stages, py::arg("output_dir") = "", py::arg("quiet") = true,
+      .def("run_stages", &run_stages, py::arg("output_dir") = py::none(), py::arg("quiet") = true,
            R"(Run the scenario's stages (as `hilldem run`). Returns {'probes': {label: {'value', 'unit',
 'quantity', 'target'}}, 'log': text, 'history_path': str, 'last_checkpoint': str}. Files (history,
 snapshots, checkpoints) are written only when output_dir is given.)")
-      .def("save_checkpoint", [](PySimulation& ps, const std::string& path) {
+      .def("save_checkpoint", [](PySimulation& ps, const std::filesystem::path& path) {
              ps.check_idle("save_checkpoint");
              save_checkpoint(ps, path);
            },
