@@ -15,11 +15,17 @@ build_dir="${1:-build}"
 #   python3-vtk9          VTK's own XML reader, to prove in a test that snapshots open in ParaView/VTK
 #   python3-matplotlib    the plots of histories (scripts/plot_history.py, docs/figures/)
 #                         and the triaxial study's figures (scripts/plot_triaxial.py, memo Figs. 18, 20-22)
+#   pybind11-dev, python3-dev
+#                         the Python module `import hilldem` (python/): the binding library and
+#                         the headers of Debian's /usr/bin/python3
+#   python3-numpy         the module's arrays (numpy views of the balls, contacts, lab-test results)
+#   python3-pytest        the module's tests (tests/python/, run by CTest)
 #   clang, libclang-rt-14-dev, libomp-14-dev
 #                         libFuzzer with AddressSanitizer/UBSan for the fuzz targets (fuzz/, run
 #                         bounded by a test), and OpenMP for that clang build
 packages=(g++ cmake make libtomlplusplus-dev libcli11-dev libfmt-dev libgtest-dev
-          python3-vtk9 python3-matplotlib clang libclang-rt-14-dev libomp-14-dev)
+          python3-vtk9 python3-matplotlib pybind11-dev python3-dev python3-numpy python3-pytest
+          clang libclang-rt-14-dev libomp-14-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -66,3 +72,15 @@ fi
 
 cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release "${pgo_args[@]}" >/dev/null
 cmake --build "$build_dir" -j"$(nproc)"
+
+# `import hilldem` for Debian's /usr/bin/python3: a hilldem.pth file in its site-packages naming the
+# build's module folder (<build-dir>/python), rewritten on every run (idempotent; the last build set
+# up is the one imported). Remove the file to undo it.
+py_site=$(/usr/bin/python3 -c 'import sysconfig; print(sysconfig.get_path("purelib"))')
+py_dir=$(cd "$build_dir/python" && pwd)
+sudo_cmd=""
+[ "$(id -u)" -ne 0 ] && sudo_cmd="sudo"
+$sudo_cmd mkdir -p "$py_site"
+echo "$py_dir" | $sudo_cmd tee "$py_site/hilldem.pth" >/dev/null
+/usr/bin/python3 -c "import hilldem" || { echo "setup: /usr/bin/python3 cannot import hilldem from $py_dir" >&2; exit 1; }
+echo "setup: /usr/bin/python3 imports hilldem from $py_dir ($py_site/hilldem.pth)"
