@@ -4,10 +4,10 @@ The engine is the C++ library the `hilldem` CLI runs (hilldem._core); this packa
 scenario builder (hilldem.ScenarioBuilder). Units are SI throughout. docs/python.md is the manual.
 """
 from ._core import (FIX_ALL, FIX_SPIN, FIX_SPIN_X, FIX_SPIN_Y, FIX_SPIN_Z, FIX_VELOCITY, FIX_X, FIX_Y, FIX_Z,
-                    InputError, RunError, Simulation, verify)
+                    InputError, RunError, Simulation, bench_bed, verify)
 from .builder import ScenarioBuilder, toml_table
 from .scenario import load_checkpoint, load_scenario, scenario_from_text
 
-__all__ = ["Simulation", "ScenarioBuilder", "load_scenario", "scenario_from_text", "load_checkpoint", "verify",
+__all__ = ["Simulation", "ScenarioBuilder", "load_scenario", "scenario_from_text", "load_checkpoint", "verify", "bench_bed",
            "InputError", "RunError", "toml_table", "FIX_X", "FIX_Y", "FIX_Z", "FIX_SPIN_X", "FIX_SPIN_Y", "FIX_SPIN_Z",
            "FIX_VELOCITY", "FIX_SPIN", "FIX_ALL"]

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "bindings.hpp"
+#include "hilldem/bench/bed_bench.hpp"
 #include "hilldem/io/checkpoint.hpp"
 #include "hilldem/io/progress.hpp"
 #include "hilldem/io/runner.hpp"
@@ -185,6 +186,18 @@ py::dict run_stages(PySimulation& ps, const std::optional<std::filesystem::path>
   return out;
 }
 
+// The bench bed of `hilldem bench` (bench/bed_bench.hpp): the LAMMPS data file, copied rep × rep in x, y.
+PySimulation bench_bed(const std::filesystem::path& data, int replicate_xy) {
+  if (replicate_xy < 1 || replicate_xy > 20)
+    throw InputError(fmt::format("bench_bed: replicate must be in [1, 20]; got {}", replicate_xy));
+  Packing packing = read_packing(data.string(), PackingFormat::Lammps);
+  const int rep[3] = {replicate_xy, replicate_xy, 1};
+  replicate(packing, rep);
+  Scenario sc;
+  sc.sim = make_bed(packing);
+  return PySimulation(std::move(sc));
+}
+
 void set_gravity(PySimulation& ps, const std::array<double, 3>& g) {
   ps.check_idle("gravity");
   for (double v : g)
@@ -313,6 +326,9 @@ snapshots, checkpoints) are written only when output_dir is given.)")
       .def_property_readonly("live_views", [](const PySimulation& ps) { return ps.live_views; },
                              "numpy views of the ball arrays alive now [-].");
   bind_arrays(cls, m);
+  m.def("bench_bed", &bench_bed, py::arg("data"), py::arg("replicate") = 1,
+        R"(The bed `hilldem bench` times, as a Simulation ready to cycle: the LAMMPS data file `data`
+(bench/bed_settled.data) copied replicate × replicate times in x and y (3: 100,800 spheres).)");
 }
 
 }  // namespace hilldem::python

@@ -76,9 +76,19 @@ def test_the_gil_is_released_while_cycling(assembly):
 def test_progress_lines(assembly, capfd):
     """progress=0.1: a line on stderr every 0.1 s of a run of a second or more."""
     start = time.monotonic()
-    while time.monotonic() - start < 1.0:
-        assembly.cycle(20000, progress=0.1)
+    assembly.cycle(10**9, callback=lambda s: time.monotonic() - start < 1.0, every=1000, progress=0.1)
     err = capfd.readouterr().err
     assert "cycle 'Simulation'" in err and "steps/s" in err and "stage" in err
     with pytest.raises(hilldem.InputError, match="progress must be the seconds"):
         assembly.cycle(1, progress=-1.0)
+
+
+def test_the_bench_bed_from_python_is_the_clis(source_dir, cli):
+    """20 steps of `hilldem bench`'s bed cycled from Python, one call per step: the CLI's digest."""
+    run = cli("bench", "--steps", 20, "--warmup", 0, "--digest")
+    digest = run.stdout.split("digest=")[1].split()[0]
+    bed = hilldem.bench_bed(source_dir / "bench" / "bed_settled.data")
+    assert bed.ball_count == 11200
+    for _ in range(20):
+        bed.cycle(1)
+    assert bed.state_digest() == digest
