@@ -1,6 +1,8 @@
 #include "hilldem/bodies/ball_store.hpp"
 
+#include <algorithm>
 #include <numbers>
+#include <numeric>
 
 #include "hilldem/core/error.hpp"
 
@@ -79,6 +81,28 @@ std::vector<std::string> group_names(const GroupNames& g) {
     names.push_back(name);
   }
   return names;
+}
+
+std::vector<std::uint32_t> spatial_order(const BallStore& balls) {
+  const std::size_t n = balls.size();
+  std::vector<std::uint32_t> order(n);
+  std::iota(order.begin(), order.end(), 0u);
+  if (n < 2) return order;
+  Vec3 lo = balls.position[0], hi = lo;
+  for (const Vec3& x : balls.position)
+    for (int d = 0; d < 3; ++d) lo[d] = std::min(lo[d], x[d]), hi[d] = std::max(hi[d], x[d]);
+  const double cell = std::max(2.0 * std::accumulate(balls.radius.begin(), balls.radius.end(), 0.0) / n, 1e-12);
+  auto cell_index = [&](const Vec3& x) {
+    const auto c = [&](int d) { return static_cast<std::uint64_t>((x[d] - lo[d]) / cell); };
+    const std::uint64_t nx = c(0) + 1;
+    const std::uint64_t ny = static_cast<std::uint64_t>((hi.y - lo.y) / cell) + 1;
+    const std::uint64_t mx = static_cast<std::uint64_t>((hi.x - lo.x) / cell) + 1;
+    return (c(2) * ny + c(1)) * mx + (nx - 1);
+  };
+  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t p, std::uint32_t q) {
+    return cell_index(balls.position[p]) < cell_index(balls.position[q]);
+  });
+  return order;
 }
 
 }  // namespace hilldem

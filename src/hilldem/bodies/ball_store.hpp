@@ -94,4 +94,8 @@ class GroupNames {
 // that does not read back as its own bit (an empty name, which describe shows as "-").
 std::vector<std::string> group_names(const GroupNames& g);
 
+// An order of the balls along a grid of cells one mean diameter wide (by z, then y, then x cell;
+// stable), for memory locality: the permutation for BallStore::permute.
+std::vector<std::uint32_t> spatial_order(const BallStore& balls);
+
 }  // namespace hilldem

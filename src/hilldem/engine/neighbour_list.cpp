@@ -125,4 +125,14 @@ void NeighbourList::build_row_lists(const ContactStore& contacts, std::size_t n)
   }
 }
 
+void NeighbourList::add_wall_motion(const Wall& w, double dt) {
+  double reach = 0.0;  // the farthest a wall point is from the centre it spins about [m]
+  if (w.shape == WallShape::Facet)
+    for (const Vec3& v : w.vertex) reach = std::max(reach, norm(v - w.rotation_center));
+  else if (w.shape == WallShape::Plane && norm2(w.spin) > 0.0)
+    reach = std::numeric_limits<double>::infinity();
+  if (norm2(w.spin) > 0.0) add_wall_travel(norm(w.spin) * dt * reach);
+  add_wall_travel((norm(w.velocity) + std::abs(w.radial_velocity)) * dt);
+}
+
 }  // namespace hilldem

@@ -64,6 +64,9 @@ class NeighbourList {
   }
   // A bound on any wall point's motion since the rebuild [m], grown by `d` [m].
   void add_wall_travel(double d) { wall_travel_ += d; }
+  // The bound grown by how far any point of wall w can move in a step of dt [s] with its velocity,
+  // radial velocity and spin (a spinning plane: unbounded, the list is rebuilt).
+  void add_wall_motion(const Wall& w, double dt);
   // A bound on the largest travel of a ball since the rebuild [m]: exact after a measuring pass over
   // the positions (set_travel_bound; 0 at a rebuild), then grown by each record motion by the step's
   // largest |V| Δt (grow_travel_bound). A bound within the limit gives the exact check's answer

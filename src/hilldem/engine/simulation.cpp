@@ -82,17 +82,7 @@ void Simulation::step_body(bool last) {
   const double* m_scaled = nullptr;
   const double* i_scaled = nullptr;
   if (settings.density_scaling) {
-    const std::size_t n = balls.size();
-    scaled_mass_.resize(n);
-    scaled_inertia_.resize(n);
-    const double want = dt / settings.timestep_safety;  // Δt/f
-#pragma omp parallel for schedule(static) if (n > kParallelMin)
-    for (std::size_t i = 0; i < n; ++i) {
-      double k_tran, k_rot;
-      stiffness_.of_ball(i, balls, contacts, neighbours_, k_tran, k_rot);
-      scaled_mass_[i] = std::max(balls.mass[i], k_tran * want * want);
-      scaled_inertia_[i] = std::max(balls.inertia[i], k_rot * want * want);
-    }
+    stiffness_.scaled_masses(balls, contacts, neighbours_, dt / settings.timestep_safety, scaled_mass_, scaled_inertia_);
     m_scaled = scaled_mass_.data();
     i_scaled = scaled_inertia_.data();
   }
@@ -105,14 +95,7 @@ void Simulation::step_body(bool last) {
                   ball_kin_.contact_sums(balls.size()));
   }
   for (Wall& w : walls.walls) {
-    // Bound on how far any point of the wall moved (for the neighbour-list check).
-    double reach = 0.0;
-    if (w.shape == WallShape::Facet)
-      for (const Vec3& v : w.vertex) reach = std::max(reach, norm(v - w.rotation_center));
-    else if (w.shape == WallShape::Plane && norm2(w.spin) > 0.0)
-      reach = std::numeric_limits<double>::infinity();
-    if (norm2(w.spin) > 0.0) neighbours_.add_wall_travel(norm(w.spin) * dt * reach);
-    neighbours_.add_wall_travel((norm(w.velocity) + std::abs(w.radial_velocity)) * dt);
+    neighbours_.add_wall_motion(w, dt);
     advance_wall(w, dt);
   }
   rebuild_if_needed();  // step 3
@@ -350,40 +333,6 @@ double Simulation::estimate_timestep() const {
   return std::isfinite(crit) ? settings.timestep_safety * crit : 0.0;
 }
 
-double Simulation::mean_unbalanced_ratio() const {
-  // PFC's mechanical ratio-average (spec lab-tests §3.4): the mean over free bodies of the
-  // unbalanced-force magnitude over the mean over the same bodies of the applied-force magnitude,
-  // that is the sum over a body's active contacts of |F_c| plus its weight m |g|. A contact's force
-  // counts as |F^s_n n̂ + F_s| + |F^m|, the magnitudes of its parts: a wet contact in equilibrium
-  // carries a Hertz force and an equal and opposite moisture force, and its net force is zero.
-  const std::size_t n = balls.size();
-  std::vector<double> applied(n, 0.0);
-  for (std::size_t c = 0; c < contacts.size(); ++c) {
-    if (!contacts.active[c]) continue;
-    const double fn = contacts.normal_force[c];
-    const double f = std::sqrt(fn * fn + norm2(contacts.shear_force(c))) + std::abs(contacts.moisture_force[c]);
-    const ContactKey& k = contacts.key[c];
-    applied[k.a] += f;
-    if (k.kind == ContactKind::BallBall) applied[k.b] += f;
-  }
-  const double g = norm(settings.gravity);
-  double unbalanced = 0.0, applied_sum = 0.0;
-  std::size_t free_balls = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const FixityMask fix = balls.fixity[i];
-    if ((fix & kFixVel) == kFixVel) continue;
-    Vec3 f = unbalanced_force(balls, i, settings.gravity);
-    for (int d = 0; d < 3; ++d)
-      if (fix & (1u << d)) f[d] = 0.0;
-    unbalanced += norm(f);
-    applied_sum += applied[i] + balls.mass[i] * g;
-    ++free_balls;
-  }
-  if (free_balls == 0) return 0.0;
-  if (applied_sum == 0.0) return unbalanced > 0.0 ? 1.0 : 0.0;
-  return unbalanced / applied_sum;  // the two means share the divisor free_balls
-}
-
 std::size_t Simulation::make_wet(double suction, double gap) {
   rebuild(std::max(gap, settings.proximity));  // step 1: every pair within the gap has a row
   neighbours_.invalidate();                     // back to the normal reach at the next cycle
@@ -430,26 +379,8 @@ long Simulation::find_ball_wall(std::int64_t ball_id, std::size_t wall) const {
 
 void Simulation::sort_balls_spatially() {
   if (contact_count() > 0) throw RunError("sort_balls_spatially: only before any contact exists");
-  const std::size_t n = balls.size();
-  if (n < 2) return;
-  // Order by cell of a grid one mean diameter wide (z, then y, then x).
-  Vec3 lo = balls.position[0], hi = lo;
-  for (const Vec3& x : balls.position)
-    for (int d = 0; d < 3; ++d) lo[d] = std::min(lo[d], x[d]), hi[d] = std::max(hi[d], x[d]);
-  const double cell = std::max(2.0 * std::accumulate(balls.radius.begin(), balls.radius.end(), 0.0) / n, 1e-12);
-  auto cell_index = [&](const Vec3& x) {
-    const auto c = [&](int d) { return static_cast<std::uint64_t>((x[d] - lo[d]) / cell); };
-    const std::uint64_t nx = c(0) + 1;
-    const std::uint64_t ny = static_cast<std::uint64_t>((hi.y - lo.y) / cell) + 1;
-    const std::uint64_t mx = static_cast<std::uint64_t>((hi.x - lo.x) / cell) + 1;
-    return (c(2) * ny + c(1)) * mx + (nx - 1);
-  };
-  std::vector<std::uint32_t> order(n);
-  std::iota(order.begin(), order.end(), 0u);
-  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t p, std::uint32_t q) {
-    return cell_index(balls.position[p]) < cell_index(balls.position[q]);
-  });
-  balls.permute(order);
+  if (balls.size() < 2) return;
+  balls.permute(spatial_order(balls));
   contacts.clear();
   invalidate_forces();
 }

@@ -21,6 +21,7 @@
 #include "hilldem/bodies/wall_store.hpp"
 #include "hilldem/contact/contact_store.hpp"
 #include "hilldem/engine/ball_records.hpp"
+#include "hilldem/engine/equilibrium.hpp"
 #include "hilldem/engine/force_pass.hpp"
 #include "hilldem/engine/hill_param_sets.hpp"
 #include "hilldem/engine/live_rows.hpp"
@@ -71,7 +72,7 @@ class Simulation {
   double estimate_timestep() const;
   // PFC's mechanical ratio-average [-]: mean unbalanced-force magnitude over free balls / mean
   // applied-force magnitude over the same balls (their contacts' |F_c| and their weight).
-  double mean_unbalanced_ratio() const;
+  double mean_unbalanced_ratio() const { return hilldem::mean_unbalanced_ratio(balls, contacts, settings.gravity); }
 
   // Material-level wetting (spec §2.7): contacts for every ball pair within gap [m] (new ones
   // included), suction [Pa] on their hill contacts, make_wet(gap) on every hill contact. Returns the

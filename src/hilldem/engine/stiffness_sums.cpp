@@ -42,4 +42,18 @@ double StiffnessSums::critical_timestep(const BallStore& balls, const ContactSto
   return std::sqrt(crit2);
 }
 
+void StiffnessSums::scaled_masses(const BallStore& balls, const ContactStore& contacts, const NeighbourList& list,
+                                  double tau, std::vector<double>& mass, std::vector<double>& inertia) const {
+  const std::size_t n = balls.size();
+  mass.resize(n);
+  inertia.resize(n);
+#pragma omp parallel for schedule(static) if (n > kParallelMin)
+  for (std::size_t i = 0; i < n; ++i) {
+    double k_tran, k_rot;
+    of_ball(i, balls, contacts, list, k_tran, k_rot);
+    mass[i] = std::max(balls.mass[i], k_tran * tau * tau);
+    inertia[i] = std::max(balls.inertia[i], k_rot * tau * tau);
+  }
+}
+
 }  // namespace hilldem

@@ -52,6 +52,11 @@ class StiffnessSums {
   // Δt_crit = min over balls of √(m/k_tran), √(I/k_rot) [s] (spec §4), or +inf if no contact
   // reports a stiffness.
   double critical_timestep(const BallStore& balls, const ContactStore& contacts, const NeighbourList& list) const;
+  // Density scaling: each ball's inertial mass and moment of inertia raised to k_tran τ² and
+  // k_rot τ² where they are smaller, so that its own critical step is at least τ = Δt/f [s]
+  // ([kg], [kg m²]; the gravity and weights keep the real mass).
+  void scaled_masses(const BallStore& balls, const ContactStore& contacts, const NeighbourList& list, double tau,
+                     std::vector<double>& mass, std::vector<double>& inertia) const;
 };
 
 }  // namespace hilldem
