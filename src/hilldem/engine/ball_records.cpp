@@ -127,4 +127,31 @@ BallRecords::Motion BallRecords::advance(BallStore& balls, const Vec3& gravity_i
   return {max_v2, max_x2, worst_live};
 }
 
+std::pair<double, double> BallRecords::largest_travel2(const BallStore& balls, const Vec3* at_build, bool live,
+                                                       const Vec3* at_live) const {
+  const std::size_t n = balls.size();
+  const bool from_records = columns_stale();
+  double worst = 0.0, worst_live = 0.0;
+#pragma omp parallel if (n > kParallelMin)
+  {
+    double mine = 0.0, mine_live = 0.0;
+#pragma omp for schedule(static) nowait
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec3& x = from_records ? kin_[i].position : balls.position[i];
+      const double d2 = norm2(x - at_build[i]);
+      if (!(d2 <= mine)) mine = d2;  // (not std::max, which would drop a NaN)
+      if (live) {
+        const double l2 = norm2(x - at_live[i]);
+        if (!(l2 <= mine_live)) mine_live = l2;
+      }
+    }
+#pragma omp critical(hilldem_largest_travel)
+    {
+      if (!(mine <= worst)) worst = mine;
+      if (!(mine_live <= worst_live)) worst_live = mine_live;
+    }
+  }
+  return {worst, worst_live};
+}
+
 }  // namespace hilldem

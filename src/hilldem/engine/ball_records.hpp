@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstddef>
+#include <utility>
 #include <vector>
 
 #include "hilldem/bodies/ball_store.hpp"
@@ -58,6 +59,12 @@ class BallRecords {
   Motion advance(BallStore& balls, const Vec3& gravity, double alpha, double dt, const double* inertial_mass,
                  const double* inertial_inertia, bool write_columns, const std::vector<double>& shares, bool live,
                  const Vec3* at_live);
+
+  // The largest squared travel of any ball [m²] since at_build (first) and since at_live (second,
+  // if live; else 0), from the records when the columns lag behind them. A NaN wins: it asks for a
+  // rebuild, which ends the run. Parallel: a maximum does not depend on the order.
+  std::pair<double, double> largest_travel2(const BallStore& balls, const Vec3* at_build, bool live,
+                                            const Vec3* at_live) const;
 
   // The sums [N], [N m]: written by the force pass, read by the law of motion while current.
   motion::ContactSums* sums() { return sums_.data(); }

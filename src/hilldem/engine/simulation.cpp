@@ -107,35 +107,13 @@ void Simulation::step_body(bool last) {
 }
 
 ContactGeometry Simulation::geometry(std::size_t c) const {
-  const ContactKey& k = contacts.key[c];
   // (Between steps the columns hold the positions; within an unwatched step the records.)
   auto position = [&](std::size_t i) -> const Vec3& { return ball_kin_.columns_stale() ? ball_kin_[i].position : balls.position[i]; };
-  const Vec3& x1 = position(k.a);
-  const double r1 = balls.radius[k.a];
-  ContactGeometry g;
-  if (k.kind == ContactKind::BallBall) {
-    Vec3 x2 = position(k.b);
-    if (contacts.image[c] != kNoImage) x2 += image_shift(contacts.image[c], settings.box);
-    const Vec3 d = x2 - x1;
-    const double dist = norm(d);
-    g.normal = dist > 0.0 ? d / dist : contacts.normal[c];  // coincident centres: keep the old normal
-    g.gap = dist - r1 - balls.radius[k.b];
-  } else {
-    const auto touch = wall_touch(walls.walls[k.b], x1, r1);
-    if (!touch) {
-      g.valid = false;
-      g.normal = contacts.normal[c];
-      g.gap = std::numeric_limits<double>::infinity();
-      g.point = x1;
-      return g;
-    }
-    g.normal = touch->normal;
-    g.gap = touch->gap;
-  }
-  g.point = x1 + g.normal * (r1 + 0.5 * g.gap);  // centre of the gap/overlap (spec §1.1)
-  return g;
+  const ContactKey& k = contacts.key[c];
+  const bool pair = k.kind == ContactKind::BallBall;
+  return contact_geometry(contacts, c, position(k.a), balls.radius[k.a], pair ? position(k.b) : Vec3{},
+                          pair ? balls.radius[k.b] : 0.0, walls, settings.box);
 }
-
 
 void Simulation::refresh_mappings() {
   body_terms_ready_ = false;
@@ -191,35 +169,10 @@ void Simulation::rebuild_if_needed() {
     // motion's bound first: the exact travel is at most the bound, so a bound within the limit gives
     // the exact check's answer without a pass over the positions (a NaN bound fails, and goes on).
     if (measured && neighbours_.holds(neighbours_.travel_bound(), half)) return;
-    // The largest squared travel since the rebuild [m²], exactly; a NaN wins (not std::max, which
-    // would drop it). Parallel: the maximum does not depend on the order, and a NaN asks for a
-    // rebuild, which ends the run (NeighbourList::rebuild). And the largest since the live rows were
-    // made, while they are. (The positions from the records when the columns lag behind them.)
-    const std::size_t n = balls.size();
-    const bool from_records = ball_kin_.columns_stale();
-    const bool live = live_.has_positions(n);
-    const Vec3* at_live = live_.positions();
-    const Vec3* at_build = neighbours_.position_at_build().data();
-    double worst = 0.0, worst_live = 0.0;
-#pragma omp parallel if (n > kParallelMin)
-    {
-      double mine = 0.0, mine_live = 0.0;
-#pragma omp for schedule(static) nowait
-      for (std::size_t i = 0; i < n; ++i) {
-        const Vec3& x = from_records ? ball_kin_[i].position : balls.position[i];
-        const double d2 = norm2(x - at_build[i]);
-        if (!(d2 <= mine)) mine = d2;
-        if (live) {
-          const double l2 = norm2(x - at_live[i]);
-          if (!(l2 <= mine_live)) mine_live = l2;
-        }
-      }
-#pragma omp critical(hilldem_rebuild_check)
-      {
-        if (!(mine <= worst)) worst = mine;
-        if (!(mine_live <= worst_live)) worst_live = mine_live;
-      }
-    }
+    // The largest travel since the rebuild, exactly, and since the live rows were made, while they are.
+    const bool live = live_.has_positions(balls.size());
+    const auto [worst, worst_live] =
+        ball_kin_.largest_travel2(balls, neighbours_.position_at_build().data(), live, live_.positions());
     live_.measured(live, worst_live);
     const double ball_travel = std::sqrt(worst);
     neighbours_.set_travel_bound(ball_travel);  // (exact now: the record motion grows it from here)

@@ -1,11 +1,12 @@
-// What a Simulation is told (SimulationSettings), what it reports of a contact's geometry
-// (ContactGeometry), and the cycle's bookkeeping that a checkpoint carries (CycleState).
+// What a Simulation is told (SimulationSettings), and the cycle's bookkeeping that a checkpoint
+// carries (CycleState).
 #pragma once
 
 #include <cstdint>
 #include <vector>
 
 #include "hilldem/contact/cell_grid.hpp"
+#include "hilldem/contact/contact_geometry.hpp"
 #include "hilldem/core/vec3.hpp"
 
 namespace hilldem {
@@ -29,13 +30,6 @@ struct SimulationSettings {
   PeriodicBox box;               // periodic directions and their period [lo, hi) [m]
 };
 
-// Geometry of a contact at the current positions.
-struct ContactGeometry {
-  Vec3 normal;        // n̂_c, piece 1 -> piece 2
-  double gap = 0.0;   // g_c [m]
-  Vec3 point;         // x_c [m]
-  bool valid = true;  // false: a ball beyond a cylinder's end (no contact possible)
-};
 
 // The cycle's private bookkeeping, for checkpoints: with it a restored run rebuilds its neighbour
 // list at the very steps the saved run would have (which matters with periodic boxes, where the
