@@ -162,6 +162,20 @@ py::dict run_stages(PySimulation& ps, const std::optional<std::filesystem::path>
   opt.output_dir = output_dir ? output_dir->string() : "";
   opt.write_files = output_dir.has_value();
   opt.progress = quiet ? ProgressMode::Off : ProgressMode::Auto;
+  // Ctrl-C: every kChunkSeconds the runner's stop hook takes the GIL and runs Python's signal
+  // handlers; an exception from one (KeyboardInterrupt) stops the run at that cycle boundary and is
+  // raised once the runner has returned.
+  std::optional<py::error_already_set> interrupted;
+  double next_check = seconds_now() + kChunkSeconds;
+  opt.stop_requested = [&] {
+    const double now = seconds_now();
+    if (now < next_check) return false;
+    next_check = now + kChunkSeconds;
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() == 0) return false;
+    interrupted.emplace();  // takes the pending Python exception
+    return true;
+  };
   std::ostringstream log;
   RunResult res;
   {
@@ -169,6 +183,7 @@ py::dict run_stages(PySimulation& ps, const std::optional<std::filesystem::path>
     py::gil_scoped_release release;
     res = ps.stepping("run_stages", [&] { return run_scenario(ps.scenario(), opt, log); });
   }
+  if (interrupted) throw std::move(*interrupted);
   py::dict probes;
   for (const ProbeValue& p : res.probes) {
     py::dict d;
@@ -272,7 +287,8 @@ their hill contacts, each made wet. Returns the number of wet contacts.)")
            },
            "Dry every hill contact; returns how many were wet.")
       .def("run_stages", &run_stages, py::arg("output_dir") = py::none(), py::arg("quiet") = true,
-           R"(Run the scenario's stages (as `hilldem run`). Returns {'probes': {label: {'value', 'unit',
+           R"(Run the scenario's stages (as `hilldem run`). Ctrl-C raises KeyboardInterrupt with the simulation at the
+cycle boundary where it stopped (no stage-end outputs are written; sim.steps says where). Returns {'probes': {label: {'value', 'unit',
 'quantity', 'target'}}, 'log': text, 'history_path': str, 'last_checkpoint': str}. Files (history,
 snapshots, checkpoints) are written only when output_dir is given.)")
       .def("save_checkpoint", [](PySimulation& ps, const std::filesystem::path& path) {
