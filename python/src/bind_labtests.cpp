@@ -257,7 +257,7 @@ results are dicts of numbers, strings and numpy arrays (docs/python.md lists the
   py::enum_<GrainModel>(lab, "GrainModel", "Grain-grain contact model of a Class 5 material.")
       .value("Linear", GrainModel::Linear)
       .value("Hill", GrainModel::Hill)
-      .def("__str__", [](GrainModel g) { return std::string(to_string(g)); });
+      .def("__str__", [](GrainModel g) { return std::string(to_string(g)); }, "'linear' or 'hill'.");
 
   py::class_<GradingBin>(lab, "GradingBin", "One bin of a grading: diameters [m] and solid-volume fraction [-].")
       .def(py::init([](double lo, double hi, double f) { return GradingBin{lo, hi, f}; }), py::arg("d_lower"),
@@ -266,8 +266,9 @@ results are dicts of numbers, strings and numpy arrays (docs/python.md lists the
       .def_readwrite("d_upper", &GradingBin::d_upper, "Upper diameter [m].")
       .def_readwrite("fraction", &GradingBin::fraction, "Solid-volume (mass) fraction [-]; the bins sum to 1.")
       .def("__repr__", [](const GradingBin& b) {
-        return fmt::format("GradingBin({:g} mm - {:g} mm, {:g})", 1e3 * b.d_lower, 1e3 * b.d_upper, b.fraction);
-      });
+             return fmt::format("GradingBin({:g} mm - {:g} mm, {:g})", 1e3 * b.d_lower, 1e3 * b.d_upper, b.fraction);
+           },
+           "The bin, diameters in mm.");
   py::class_<Grading>(lab, "Grading", "A grain-size distribution: a name and non-overlapping bins (lab-tests.md §1).")
       .def(py::init([](std::string name, std::vector<GradingBin> bins) {
              Grading g{std::move(name), std::move(bins)};
@@ -277,7 +278,8 @@ results are dicts of numbers, strings and numpy arrays (docs/python.md lists the
            py::arg("name"), py::arg("bins"), "A grading from bins; InputError unless they are a valid grading.")
       .def_readwrite("name", &Grading::name, "C5n, C5b or the file name.")
       .def_readwrite("bins", &Grading::bins, "The bins (a list of GradingBin; assign a new list to change them).")
-      .def("__repr__", [](const Grading& g) { return fmt::format("Grading('{}', {} bins)", g.name, g.bins.size()); });
+      .def("__repr__", [](const Grading& g) { return fmt::format("Grading('{}', {} bins)", g.name, g.bins.size()); },
+           "Its name and bin count.");
   lab.def("grading", &resolve_grading, py::arg("name_or_file"),
           R"(A grading: "C5n" or "C5b" (the memo's Table 7), or a CSV file of d_lower_mm,d_upper_mm,fraction
 rows. InputError naming the file, line and value on bad input.)");
@@ -311,7 +313,7 @@ rows. InputError naming the file, line and value on bad input.)");
 (fractions passing [-])}, 'csv', 'text'}.)");
 
   py::class_<Class5Material>(lab, "Class5Material", "Grain-grain properties of a Class 5 material (memo Table 7).")
-      .def(py::init<>())
+      .def(py::init<>(), "The header's defaults.")
       .def_readwrite("model", &Class5Material::model, "GrainModel.Hill or GrainModel.Linear.")
       .def_readwrite("density", &Class5Material::density, "Grain density [kg/m^3].")
       .def_readwrite("young_mod", &Class5Material::young_mod, "Grain Young's modulus [Pa] (hill).")
@@ -322,19 +324,19 @@ rows. InputError naming the file, line and value on bad input.)");
       .def_readwrite("linear_kratio", &Class5Material::linear_kratio, "Stiffness ratio kappa* [-] (linear).")
       .def_readwrite("fric", &Class5Material::fric, "Friction coefficient mu [-].");
   py::class_<WallContact>(lab, "WallContact", "Grain-wall contacts: linear (lab-tests.md §2).")
-      .def(py::init<>())
+      .def(py::init<>(), "The header's defaults.")
       .def_readwrite("emod", &WallContact::emod, "Effective modulus E* [Pa].")
       .def_readwrite("kratio", &WallContact::kratio, "Stiffness ratio kappa* [-].")
       .def_readwrite("fric", &WallContact::fric, "Friction coefficient [-].");
   py::class_<PackingContact>(lab, "PackingContact", "Grain-grain contacts during packing (lab-tests.md §3.2).")
-      .def(py::init<>())
+      .def(py::init<>(), "The header's defaults.")
       .def_readwrite("model", &PackingContact::model, "GrainModel of the packing contacts.")
       .def_readwrite("emod", &PackingContact::emod, "E* [Pa] (linear).")
       .def_readwrite("kratio", &PackingContact::kratio, "kappa* [-] (linear).")
       .def_readwrite("damp_con", &PackingContact::damp_con, "gamma_h [-] (hill).")
       .def_readwrite("fric", &PackingContact::fric, "Packing friction mu_CA [-].");
   py::class_<EquilibriumSettings>(lab, "EquilibriumSettings", "Servo-controlled equilibrium of the three vessel walls.")
-      .def(py::init<>())
+      .def(py::init<>(), "The header's defaults.")
       .def_readwrite("pressure", &EquilibriumSettings::pressure, "Target wall pressure [Pa].")
       .def_readwrite("pressure_tolerance", &EquilibriumSettings::pressure_tolerance, "Every wall within this x pressure [-].")
       .def_readwrite("ratio", &EquilibriumSettings::ratio, "Mean unbalanced-force ratio to reach [-].")
@@ -343,7 +345,7 @@ rows. InputError naming the file, line and value on bad input.)");
       .def_readwrite("check_every", &EquilibriumSettings::check_every, "Cycles between convergence checks [-].")
       .def_readwrite("max_steps", &EquilibriumSettings::max_steps, "RunError after this many cycles [-].");
   py::class_<PackingSettings>(lab, "PackingSettings", "The grain cloud and its frictionless packing (lab-tests.md §3).")
-      .def(py::init<>())
+      .def(py::init<>(), "The header's defaults.")
       .def_readwrite("seed", &PackingSettings::seed, "Random seed N_RS of the cloud [-].")
       .def_readwrite("cloud_porosity", &PackingSettings::cloud_porosity, "Cloud porosity n_c [-].")
       .def_readwrite("local_damping", &PackingSettings::local_damping, "Local damping alpha [-].")
@@ -355,7 +357,7 @@ rows. InputError naming the file, line and value on bad input.)");
       .def_readwrite("contact", &PackingSettings::contact, "PackingContact.")
       .def_readwrite("walls", &PackingSettings::walls, "WallContact during packing.");
   py::class_<GenesisSpec>(lab, "GenesisSpec", "What pack_specimen makes: grading, vessel, grains, packing.")
-      .def(py::init<>())
+      .def(py::init<>(), "The header's defaults.")
       .def_readwrite("grading", &GenesisSpec::grading, "Grading (default C5b).")
       .def_readwrite("d_mult", &GenesisSpec::d_mult, "Diameter multiplier D_mult [-].")
       .def_readwrite("vessel_radius", &GenesisSpec::vessel_radius, "Vessel radius [m] (default the memo's 0.085).")
@@ -363,7 +365,7 @@ rows. InputError naming the file, line and value on bad input.)");
       .def_readwrite("grain", &GenesisSpec::grain, "Class5Material whose density, E and nu the grains take.")
       .def_readwrite("packing", &GenesisSpec::packing, "PackingSettings.");
   py::class_<TriaxialSettings>(lab, "TriaxialSettings", "The servo-controlled triaxial test (lab-tests.md §4).")
-      .def(py::init<>())
+      .def(py::init<>(), "The header's defaults.")
       .def_readwrite("confinement", &TriaxialSettings::confinement, "Confining pressure sigma_c [Pa].")
       .def_readwrite("cycle_strains", &TriaxialSettings::cycle_strains,
                      "Axial strains [-] (fractions, not %) at which each unloading starts, increasing.")
@@ -380,16 +382,17 @@ rows. InputError naming the file, line and value on bad input.)");
       .def_readwrite("max_steps", &TriaxialSettings::max_steps, "RunError after this many cycles [-].");
   py::class_<CaseSpec>(lab, "CaseSpec", "One case of the study: grading x material, dry or wet.")
       .def(py::init([](std::string grading, GrainModel model, bool wet) { return CaseSpec{std::move(grading), model, wet}; }),
-           py::arg("grading") = "C5b", py::arg("model") = GrainModel::Hill, py::arg("wet") = false)
+           py::arg("grading") = "C5b", py::arg("model") = GrainModel::Hill, py::arg("wet") = false,
+           "A case: grading name or file, GrainModel, wet.")
       .def_readwrite("grading", &CaseSpec::grading, "C5n, C5b or a grading CSV file.")
       .def_readwrite("model", &CaseSpec::model, "GrainModel.")
       .def_readwrite("wet", &CaseSpec::wet, "make_wet at the end of genesis (hill only).")
       .def_property_readonly("name", &CaseSpec::name, "The case's name, e.g. C5b_Hill_wet.")
-      .def("__repr__", [](const CaseSpec& c) { return "CaseSpec('" + c.name() + "')"; });
+      .def("__repr__", [](const CaseSpec& c) { return "CaseSpec('" + c.name() + "')"; }, "Its name.");
   py::class_<StudySettings>(lab, "StudySettings", R"(Settings of study(): genesis, material, finalization, wetting, the
 triaxial test, output. Defaults are the headers' (the memo's full 170 mm x 240 mm vessel; the CLI's
 default is half that: genesis.vessel_radius = 0.0425, vessel_height = 0.120).)")
-      .def(py::init<>())
+      .def(py::init<>(), "The header's defaults.")
       .def_readwrite("genesis", &StudySettings::genesis, "GenesisSpec (its grading is replaced by each case's).")
       .def_readwrite("material", &StudySettings::material, "Class5Material (its model is replaced by each case's).")
       .def_readwrite("test_walls", &StudySettings::test_walls, "WallContact after finalization.")
