@@ -256,8 +256,7 @@ results are dicts of numbers, strings and numpy arrays (docs/python.md lists the
 
   py::enum_<GrainModel>(lab, "GrainModel", "Grain-grain contact model of a Class 5 material.")
       .value("Linear", GrainModel::Linear)
-      .value("Hill", GrainModel::Hill)
-      .def("__str__", [](GrainModel g) { return std::string(to_string(g)); }, "'linear' or 'hill'.");
+      .value("Hill", GrainModel::Hill);
 
   py::class_<GradingBin>(lab, "GradingBin", "One bin of a grading: diameters [m] and solid-volume fraction [-].")
       .def(py::init([](double lo, double hi, double f) { return GradingBin{lo, hi, f}; }), py::arg("d_lower"),

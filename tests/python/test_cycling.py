@@ -112,5 +112,8 @@ def test_ctrl_c_stops_the_stages_between_cycles(source_dir):
     assert time.monotonic() - start < 5.0
     steps = sim.steps
     assert 0 < steps < 10**9
+    fresh = hilldem.scenario_from_text(text, "long.toml")
+    fresh.cycle(steps)
+    assert sim.state_difference(fresh) == ""  # stopped cleanly, at a cycle boundary
     sim.cycle(10)
     assert sim.steps == steps + 10 and sim.failure == ""
