@@ -5,10 +5,10 @@
 
 Without --checkpoint, the memo's 27-grain assembly (examples/assembly_27.toml) is settled under
 gravity from Python and saved with Simulation.save_checkpoint; any checkpoint works, including a CLI
-run's (`hilldem run ... ` with [checkpoints]: out/<run>/checkpoints/*.ckpt). The checkpoint is read
-back with hilldem.load_checkpoint, and each contact is drawn in the x-z plane as a line from ball
-centre to ball centre (to the contact point for a wall), its width proportional to the normal force
-[N]. --quick settles to a looser ratio."""
+run's (`hilldem run ... --checkpoint-every N`: out/<run>/checkpoints/ckpt-*.hdc). The checkpoint is
+read back with hilldem.load_checkpoint, and each contact is drawn in the x-z plane as a line from
+ball centre to ball centre (to the contact point for a wall), its width proportional to the normal
+force [N]. --quick settles to a looser ratio."""
 import argparse
 import pathlib
 import sys
@@ -68,7 +68,7 @@ def main():
     a = ap.parse_args()
     out = pathlib.Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
-    ckpt = pathlib.Path(a.checkpoint) if a.checkpoint else out / "assembly_27.ckpt"
+    ckpt = pathlib.Path(a.checkpoint) if a.checkpoint else out / "assembly_27.hdc"
     if not a.checkpoint:
         make_checkpoint(ckpt, 1e-3 if a.quick else 1e-5)
     sim = hilldem.load_checkpoint(ckpt)
