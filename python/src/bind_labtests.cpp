@@ -429,7 +429,8 @@ genesis history. The drivers (finalize, make_wet, triaxial) change it in place: 
              save_packed_specimen(s, p, path.string());
            },
            py::arg("path"), py::arg("packing") = PackingSettings{},
-           "Write a packed (not finalized) specimen for load_specimen or `hilldem triaxial --specimen`.");
+           R"(Write a packed (not finalized) specimen for load_specimen or `hilldem triaxial --specimen`; packing:
+the PackingSettings it was packed with (its contact and wall settings are recorded in the file).)");
 
   lab.def("pack_specimen", [](const GenesisSpec& spec, bool log) {
             validate(spec);
