@@ -12,7 +12,8 @@ and q_peak against mu with the target) is written to <out>/calibrate_friction.pn
 
 The default is small and fast: the memo's vessel scaled by 0.15 (25 mm x 36 mm) of 5.6-8 mm grains,
 about 45 grains. A realistic run: --scale 0.5 --grading C5b --iterations 8 (about 1,900 grains; an
-hour or more). --quick: 3 trials and loading to 0.5 %, for the test suite."""
+hour or more). --quick: 3 trials and loading to 0.5 %, for the test suite. Exit status 1 when the
+best trial misses the target by more than --tolerance."""
 import argparse
 import pathlib
 import sys
@@ -56,6 +57,8 @@ def main():
     ap.add_argument("--final-strain", type=float, default=0.01, help="axial strain of the test [-] (0.01 = 1 %%)")
     ap.add_argument("--confinement", type=float, default=150e3, help="confining pressure sigma_c [Pa]")
     ap.add_argument("--seed", type=int, default=42, help="seed of the grain cloud")
+    ap.add_argument("--tolerance", type=float, default=0.05,
+                    help="exit status 1 unless the best trial is within this fraction of the target [-]")
     ap.add_argument("--out", default="out/python_examples", help="folder of the figure")
     a = ap.parse_args()
     if a.quick:
@@ -131,7 +134,7 @@ def main():
     png = out / "calibrate_friction.png"
     fig.savefig(png, dpi=110)
     print(f"figure {png}")
-    return 0
+    return 0 if abs(best[1] / a.target - 1) <= a.tolerance else 1
 
 
 if __name__ == "__main__":
