@@ -5,8 +5,9 @@ a line like the CLI's, to measure what driving the engine from Python costs.
     /usr/bin/python3 bench/python_bench.py [--replicate 3] [--warmup 200] [--steps 1000] [--chunk 0]
                                            [--digest]
 
---chunk 0 runs the timed steps as one cycle(steps) call (which the module cuts into chunks of about
-0.05 s to answer Ctrl-C); --chunk N calls cycle(N) in a Python loop (N = 1: one call per cycle)."""
+--chunk 0 runs the timed steps as one cycle(steps) call (one engine call, which polls for Ctrl-C
+every 0.05 s); --chunk N calls cycle(N) in a Python loop (N = 1: one call per cycle). OpenMP threads:
+OMP_NUM_THREADS (`hilldem bench --threads`)."""
 import argparse
 import pathlib
 import time

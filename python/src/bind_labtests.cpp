@@ -1,11 +1,21 @@
-// The memo's checks (hilldem verify) and the lab tests (grading, genesis, triaxial, study) as
-// functions returning dicts and numpy arrays.
+// The memo's checks (hilldem verify) and the lab tests of src/hilldem/labtests/ (grading, genesis,
+// triaxial test, study) for Python, in the submodule hilldem.lab: the settings structs as classes
+// with one attribute per C++ field (defaults and units those of the headers), the drivers as
+// functions, and their results as dicts and numpy arrays. A field added to a settings struct is one
+// .def_readwrite line here; one added to a result struct, one PUT line.
+#include <fmt/format.h>
+#include <pybind11/numpy.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
+#include <iostream>
 #include <sstream>
 
 #include "bindings.hpp"
+#include "hilldem/labtests/specimen_io.hpp"
+#include "hilldem/labtests/study.hpp"
 #include "hilldem/verify/verify.hpp"
+#include "py_simulation.hpp"
 
 namespace py = pybind11;
 
@@ -39,12 +49,441 @@ py::dict verify() {
   return out;
 }
 
+// d["field"] = object.field: result structs to dicts, one line per field (units: the struct's header).
+#define PUT(d, obj, field) d[#field] = (obj).field
+
+// A numpy column of a row vector: out[k] = rows[k].*member.
+template <class Row, class T>
+py::array_t<T> column(const std::vector<Row>& rows, T Row::*member) {
+  py::array_t<T> a(static_cast<py::ssize_t>(rows.size()));
+  auto m = a.template mutable_unchecked<1>();
+  for (std::size_t k = 0; k < rows.size(); ++k) m(static_cast<py::ssize_t>(k)) = rows[k].*member;
+  return a;
+}
+
+const char* margin_name(SpecimenState::Margin m) {
+  switch (m) {
+    case SpecimenState::Margin::DMax: return "d_max";
+    case SpecimenState::Margin::D50: return "d50";
+    case SpecimenState::Margin::None: return "none";
+  }
+  return "?";
+}
+
+py::dict state_dict(const SpecimenState& s) {
+  py::dict d;
+  PUT(d, s, grains);
+  PUT(d, s, porosity);
+  PUT(d, s, interior_porosity);
+  d["interior_margin"] = margin_name(s.interior_margin);
+  PUT(d, s, interior_margin_length);
+  PUT(d, s, coordination);
+  PUT(d, s, mech_coordination);
+  PUT(d, s, radial_stress);
+  PUT(d, s, bottom_stress);
+  PUT(d, s, top_stress);
+  PUT(d, s, radius);
+  PUT(d, s, height);
+  PUT(d, s, ratio);
+  PUT(d, s, wet_contacts);
+  PUT(d, s, timestep);
+  return d;
+}
+
+py::dict phase_dict(const PhaseReport& p) {
+  py::dict d;
+  PUT(d, p, name);
+  PUT(d, p, steps);
+  PUT(d, p, seconds);
+  d["state"] = state_dict(p.state);
+  d["line"] = p.line();
+  return d;
+}
+
+py::list phase_list(const std::vector<PhaseReport>& phases) {
+  py::list out;
+  for (const PhaseReport& p : phases) out.append(phase_dict(p));
+  return out;
+}
+
+py::dict grading_report_dict(const GradingReport& g) {
+  py::dict d;
+  PUT(d, g, name);
+  PUT(d, g, count);
+  PUT(d, g, outside);
+  PUT(d, g, d50_target);
+  PUT(d, g, d50_realised);
+  PUT(d, g, worst_bin_error);
+  py::dict bins;
+  std::vector<GradingBin> b;
+  for (const BinReport& r : g.bins) b.push_back(r.bin);
+  bins["d_lower"] = column(b, &GradingBin::d_lower);
+  bins["d_upper"] = column(b, &GradingBin::d_upper);
+  bins["target_fraction"] = column(b, &GradingBin::fraction);
+  bins["realised_fraction"] = column(g.bins, &BinReport::realised_fraction);
+  bins["count"] = column(g.bins, &BinReport::count);
+  d["bins"] = bins;
+  py::dict curve;
+  curve["size"] = column(g.curve, &PassingPoint::size);
+  curve["target"] = column(g.curve, &PassingPoint::target);
+  curve["realised"] = column(g.curve, &PassingPoint::realised);
+  d["curve"] = curve;
+  d["csv"] = g.csv();
+  d["text"] = g.text();
+  return d;
+}
+
+py::dict loop_dict(const LoopResult& l) {
+  py::dict d;
+  PUT(d, l, cycle);
+  PUT(d, l, target_strain);
+  PUT(d, l, eps_a);
+  PUT(d, l, q_a);
+  PUT(d, l, eps_b);
+  PUT(d, l, q_b);
+  PUT(d, l, q_c);
+  PUT(d, l, closed);
+  PUT(d, l, unload_secant);
+  PUT(d, l, reload_secant);
+  PUT(d, l, loop_area);
+  PUT(d, l, damping_ratio);
+  return d;
+}
+
+py::dict triaxial_dict(const TriaxialResult& t) {
+  py::dict h;
+  h["step"] = column(t.history, &TriaxialRow::step);
+  h["time"] = column(t.history, &TriaxialRow::time);
+  py::list phase;
+  for (const TriaxialRow& r : t.history) phase.append(to_string(r.phase));
+  h["phase"] = py::module_::import("numpy").attr("array")(phase);
+  h["cycle"] = column(t.history, &TriaxialRow::cycle);
+  h["eps_a"] = column(t.history, &TriaxialRow::eps_a);
+  h["eps_r"] = column(t.history, &TriaxialRow::eps_r);
+  h["eps_v"] = column(t.history, &TriaxialRow::eps_v);
+  h["sigma_a"] = column(t.history, &TriaxialRow::sigma_a);
+  h["sigma_r"] = column(t.history, &TriaxialRow::sigma_r);
+  h["q"] = column(t.history, &TriaxialRow::q);
+  h["sigma_top"] = column(t.history, &TriaxialRow::sigma_top);
+  h["sigma_bottom"] = column(t.history, &TriaxialRow::sigma_bottom);
+  h["porosity"] = column(t.history, &TriaxialRow::porosity);
+  h["coordination"] = column(t.history, &TriaxialRow::coordination);
+  h["platen_mismatch"] = column(t.history, &TriaxialRow::platen_mismatch);
+  py::dict d;
+  d["history"] = h;
+  py::list loops;
+  for (const LoopResult& l : t.loops) loops.append(loop_dict(l));
+  d["loops"] = loops;
+  PUT(d, t, height0);
+  PUT(d, t, radius0);
+  PUT(d, t, peak_q);
+  PUT(d, t, peak_strain);
+  PUT(d, t, worst_confinement_error);
+  PUT(d, t, worst_confinement_strain);
+  PUT(d, t, worst_platen_mismatch);
+  PUT(d, t, worst_mismatch_strain);
+  PUT(d, t, steps);
+  PUT(d, t, seconds);
+  d["history_csv"] = t.history_csv();
+  d["loops_text"] = t.loops_text();
+  return d;
+}
+
+py::dict case_dict(const CaseResult& c) {
+  py::dict d;
+  d["name"] = c.spec.name();
+  PUT(d, c, spec);
+  d["grading"] = grading_report_dict(c.grading);
+  PUT(d, c, packed_with);
+  d["packed"] = state_dict(c.packed);
+  d["initial"] = state_dict(c.initial);
+  d["phases"] = phase_list(c.phases);
+  d["test"] = triaxial_dict(c.test);
+  PUT(d, c, seconds);
+  PUT(d, c, packing_seconds);
+  PUT(d, c, dir);
+  PUT(d, c, packing_file);
+  return d;
+}
+
+py::dict study_dict(const StudyResult& s) {
+  py::dict d;
+  py::list cases;
+  for (const CaseResult& c : s.cases) cases.append(case_dict(c));
+  d["cases"] = cases;
+  PUT(d, s, seconds);
+  PUT(d, s, cpu_seconds);
+  d["summary_csv"] = s.summary_csv();
+  d["summary_markdown"] = s.summary_markdown();
+  d["findings"] = s.findings();
+  return d;
+}
+#undef PUT
+
+// A driver's log: the console (as the CLI prints it) or nothing.
+std::ostream* log_stream(bool log) { return log ? &std::cout : nullptr; }
+
+// Runs f() with the GIL released (the drivers run for seconds to hours; Python threads go on).
+template <class F>
+auto released(F&& f) {
+  py::gil_scoped_release release;
+  return f();
+}
+
+py::array_t<double> diameters(const Specimen& s) {
+  const std::vector<double> d = s.diameters();
+  return py::array_t<double>(static_cast<py::ssize_t>(d.size()), d.data());
+}
+
+// The specimen's simulation, copied into a hilldem.Simulation (numpy views, contacts(), checkpoints).
+PySimulation specimen_simulation(const Specimen& s) {
+  Scenario sc;
+  sc.sim = s.sim;
+  return PySimulation(std::move(sc));
+}
+
 }  // namespace
 
 void bind_labtests(py::module_& m) {
   m.def("verify", &verify,
         R"(Run the memo's test problems (as `hilldem verify`). Returns {id: {'quantity', 'unit', 'memo',
 'computed', 'tolerance', 'relative', 'pass', 'produced', 'scenario'}}, values in the row's unit.)");
+
+  py::module_ lab = m.def_submodule("lab", R"(The lab tests (docs/lab-tests.md): gradings, material genesis, the
+servo-controlled triaxial test and the Class 5 study, as `hilldem triaxial` runs them. Settings are
+classes with one attribute per setting (SI units: [m], [Pa], [1/s]; strains as fractions [-], not %);
+results are dicts of numbers, strings and numpy arrays (docs/python.md lists them with units).)");
+
+  py::enum_<GrainModel>(lab, "GrainModel", "Grain-grain contact model of a Class 5 material.")
+      .value("Linear", GrainModel::Linear)
+      .value("Hill", GrainModel::Hill);
+
+  py::class_<GradingBin>(lab, "GradingBin", "One bin of a grading: diameters [m] and solid-volume fraction [-].")
+      .def(py::init([](double lo, double hi, double f) { return GradingBin{lo, hi, f}; }), py::arg("d_lower"),
+           py::arg("d_upper"), py::arg("fraction"))
+      .def_readwrite("d_lower", &GradingBin::d_lower, "Lower diameter [m].")
+      .def_readwrite("d_upper", &GradingBin::d_upper, "Upper diameter [m].")
+      .def_readwrite("fraction", &GradingBin::fraction, "Solid-volume (mass) fraction [-]; the bins sum to 1.")
+      .def("__repr__", [](const GradingBin& b) {
+             return fmt::format("GradingBin({:g} mm - {:g} mm, {:g})", 1e3 * b.d_lower, 1e3 * b.d_upper, b.fraction);
+           },
+           "The bin, diameters in mm.");
+  py::class_<Grading>(lab, "Grading", "A grain-size distribution: a name and non-overlapping bins (lab-tests.md §1).")
+      .def(py::init([](std::string name, std::vector<GradingBin> bins) {
+             Grading g{std::move(name), std::move(bins)};
+             validate_grading(g);
+             return g;
+           }),
+           py::arg("name"), py::arg("bins"), "A grading from bins; InputError unless they are a valid grading.")
+      .def_readwrite("name", &Grading::name, "C5n, C5b or the file name.")
+      .def_readwrite("bins", &Grading::bins, "The bins (a list of GradingBin; assign a new list to change them).")
+      .def("__repr__", [](const Grading& g) { return fmt::format("Grading('{}', {} bins)", g.name, g.bins.size()); },
+           "Its name and bin count.");
+  lab.def("grading", &resolve_grading, py::arg("name_or_file"),
+          R"(A grading: "C5n" or "C5b" (the memo's Table 7), or a CSV file of d_lower_mm,d_upper_mm,fraction
+rows. InputError naming the file, line and value on bad input.)");
+  lab.def("expected_grain_count", &expected_grain_count, py::arg("grading"), py::arg("d_mult"), py::arg("solid_volume"),
+          "Expected number of grains [-] for a solid volume [m^3] with diameters scaled by d_mult [-].");
+  lab.def("sample_grains",
+          [](const Grading& g, double solid_volume, std::uint64_t seed, double d_mult) {
+            validate_grading(g);
+            if (!(solid_volume > 0.0) || !std::isfinite(solid_volume))
+              throw InputError(fmt::format("sample_grains: solid_volume must be in (0, inf) [m^3]; got {}", solid_volume));
+            if (!(d_mult > 0.0) || !std::isfinite(d_mult))
+              throw InputError(fmt::format("sample_grains: d_mult must be in (0, inf) [-]; got {}", d_mult));
+            Rng rng(seed);
+            const GrainSample s = sample_grains(g, d_mult, solid_volume, rng);
+            py::dict d;
+            d["diameters"] = py::array_t<double>(static_cast<py::ssize_t>(s.diameters.size()), s.diameters.data());
+            d["bin"] = py::array_t<int>(static_cast<py::ssize_t>(s.bin.size()), s.bin.data());
+            return d;
+          },
+          py::arg("grading"), py::arg("solid_volume"), py::arg("seed") = PackingSettings{}.seed, py::arg("d_mult") = 1.0,
+          R"(Grains drawn from the grading for a solid volume [m^3] with the seeded generator genesis uses:
+{'diameters': [m], 'bin': bin index of each grain}.)");
+  lab.def("grading_report",
+          [](const Grading& g, const py::array_t<double, py::array::c_style | py::array::forcecast>& d, double d_mult) {
+            return grading_report_dict(grading_report(g, d_mult, std::vector<double>(d.data(), d.data() + d.size())));
+          },
+          py::arg("grading"), py::arg("diameters"), py::arg("d_mult") = 1.0,
+          R"(The realised distribution of diameters [m] against the grading (memo Fig. 18): {'name', 'count',
+'outside', 'd50_target', 'd50_realised' [m], 'worst_bin_error' [-], 'bins': {'d_lower', 'd_upper' [m],
+'target_fraction', 'realised_fraction' [-], 'count'}, 'curve': {'size' [m], 'target', 'realised'
+(fractions passing [-])}, 'csv', 'text'}.)");
+
+  py::class_<Class5Material>(lab, "Class5Material", "Grain-grain properties of a Class 5 material (memo Table 7).")
+      .def(py::init<>(), "The header's defaults.")
+      .def_readwrite("model", &Class5Material::model, "GrainModel.Hill or GrainModel.Linear.")
+      .def_readwrite("density", &Class5Material::density, "Grain density [kg/m^3].")
+      .def_readwrite("young_mod", &Class5Material::young_mod, "Grain Young's modulus [Pa] (hill).")
+      .def_readwrite("pois_ratio", &Class5Material::pois_ratio, "Grain Poisson's ratio [-] (hill).")
+      .def_readwrite("damp_con", &Class5Material::damp_con, "Damping constant gamma_h [-] (hill).")
+      .def_readwrite("suction", &Class5Material::suction, "Suction [Pa] of the hill contacts (wet contacts only).")
+      .def_readwrite("linear_emod", &Class5Material::linear_emod, "Effective modulus E* [Pa] (linear).")
+      .def_readwrite("linear_kratio", &Class5Material::linear_kratio, "Stiffness ratio kappa* [-] (linear).")
+      .def_readwrite("fric", &Class5Material::fric, "Friction coefficient mu [-].");
+  py::class_<WallContact>(lab, "WallContact", "Grain-wall contacts: linear (lab-tests.md §2).")
+      .def(py::init<>(), "The header's defaults.")
+      .def_readwrite("emod", &WallContact::emod, "Effective modulus E* [Pa].")
+      .def_readwrite("kratio", &WallContact::kratio, "Stiffness ratio kappa* [-].")
+      .def_readwrite("fric", &WallContact::fric, "Friction coefficient [-].");
+  py::class_<PackingContact>(lab, "PackingContact", "Grain-grain contacts during packing (lab-tests.md §3.2).")
+      .def(py::init<>(), "The header's defaults.")
+      .def_readwrite("model", &PackingContact::model, "GrainModel of the packing contacts.")
+      .def_readwrite("emod", &PackingContact::emod, "E* [Pa] (linear).")
+      .def_readwrite("kratio", &PackingContact::kratio, "kappa* [-] (linear).")
+      .def_readwrite("damp_con", &PackingContact::damp_con, "gamma_h [-] (hill).")
+      .def_readwrite("fric", &PackingContact::fric, "Packing friction mu_CA [-].");
+  py::class_<EquilibriumSettings>(lab, "EquilibriumSettings", "Servo-controlled equilibrium of the three vessel walls.")
+      .def(py::init<>(), "The header's defaults.")
+      .def_readwrite("pressure", &EquilibriumSettings::pressure, "Target wall pressure [Pa].")
+      .def_readwrite("pressure_tolerance", &EquilibriumSettings::pressure_tolerance, "Every wall within this x pressure [-].")
+      .def_readwrite("ratio", &EquilibriumSettings::ratio, "Mean unbalanced-force ratio to reach [-].")
+      .def_readwrite("servo_gain", &EquilibriumSettings::servo_gain, "Servo gain alpha_s [-].")
+      .def_readwrite("wall_speed_limit", &EquilibriumSettings::wall_speed_limit, "Wall speed cap [m/s].")
+      .def_readwrite("check_every", &EquilibriumSettings::check_every, "Cycles between convergence checks [-].")
+      .def_readwrite("max_steps", &EquilibriumSettings::max_steps, "RunError after this many cycles [-].");
+  py::class_<PackingSettings>(lab, "PackingSettings", "The grain cloud and its frictionless packing (lab-tests.md §3).")
+      .def(py::init<>(), "The header's defaults.")
+      .def_readwrite("seed", &PackingSettings::seed, "Random seed N_RS of the cloud [-].")
+      .def_readwrite("cloud_porosity", &PackingSettings::cloud_porosity, "Cloud porosity n_c [-].")
+      .def_readwrite("local_damping", &PackingSettings::local_damping, "Local damping alpha [-].")
+      .def_readwrite("placement_tries", &PackingSettings::placement_tries, "Random positions tried per grain [-].")
+      .def_readwrite("cloud_speed_limit", &PackingSettings::cloud_speed_limit, "Grain speed cap in the relaxation [m/s].")
+      .def_readwrite("cloud_overlap", &PackingSettings::cloud_overlap, "Relaxation ends at overlaps <= this x smallest diameter [-].")
+      .def_readwrite("cloud_max_steps", &PackingSettings::cloud_max_steps, "Cycles allowed for the relaxation [-].")
+      .def_readwrite("equilibrium", &PackingSettings::equilibrium, "EquilibriumSettings of packing (P_m).")
+      .def_readwrite("contact", &PackingSettings::contact, "PackingContact.")
+      .def_readwrite("walls", &PackingSettings::walls, "WallContact during packing.");
+  py::class_<GenesisSpec>(lab, "GenesisSpec", "What pack_specimen makes: grading, vessel, grains, packing.")
+      .def(py::init<>(), "The header's defaults.")
+      .def_readwrite("grading", &GenesisSpec::grading, "Grading (default C5b).")
+      .def_readwrite("d_mult", &GenesisSpec::d_mult, "Diameter multiplier D_mult [-].")
+      .def_readwrite("vessel_radius", &GenesisSpec::vessel_radius, "Vessel radius [m] (default the memo's 0.085).")
+      .def_readwrite("vessel_height", &GenesisSpec::vessel_height, "Vessel height [m] (default the memo's 0.240).")
+      .def_readwrite("grain", &GenesisSpec::grain, "Class5Material whose density, E and nu the grains take.")
+      .def_readwrite("packing", &GenesisSpec::packing, "PackingSettings.");
+  py::class_<TriaxialSettings>(lab, "TriaxialSettings", "The servo-controlled triaxial test (lab-tests.md §4).")
+      .def(py::init<>(), "The header's defaults.")
+      .def_readwrite("confinement", &TriaxialSettings::confinement, "Confining pressure sigma_c [Pa].")
+      .def_readwrite("cycle_strains", &TriaxialSettings::cycle_strains,
+                     "Axial strains [-] (fractions, not %) at which each unloading starts, increasing.")
+      .def_readwrite("unload_fraction", &TriaxialSettings::unload_fraction, "Unload until q <= this x q at the reversal [-].")
+      .def_readwrite("final_strain", &TriaxialSettings::final_strain, "Final axial strain [-].")
+      .def_readwrite("strain_rate", &TriaxialSettings::strain_rate, "Axial strain rate during the cycles [1/s].")
+      .def_readwrite("final_strain_rate", &TriaxialSettings::final_strain_rate, "Axial strain rate after them [1/s].")
+      .def_readwrite("servo_gain", &TriaxialSettings::servo_gain, "Radial servo gain [-].")
+      .def_readwrite("wall_speed_limit", &TriaxialSettings::wall_speed_limit, "Radial servo speed cap [m/s].")
+      .def_readwrite("cycle_record_strain", &TriaxialSettings::cycle_record_strain,
+                     "History row every this much axial strain in the cycles [-] (0: 1/100 of the first cycle strain).")
+      .def_readwrite("final_records", &TriaxialSettings::final_records, "History rows of the final loading [-].")
+      .def_readwrite("density_scaling", &TriaxialSettings::density_scaling, "Density scaling factor F [-]: 0 (off) or [1, 50].")
+      .def_readwrite("max_steps", &TriaxialSettings::max_steps, "RunError after this many cycles [-].");
+  py::class_<CaseSpec>(lab, "CaseSpec", "One case of the study: grading x material, dry or wet.")
+      .def(py::init([](std::string grading, GrainModel model, bool wet) { return CaseSpec{std::move(grading), model, wet}; }),
+           py::arg("grading") = "C5b", py::arg("model") = GrainModel::Hill, py::arg("wet") = false,
+           "A case: grading name or file, GrainModel, wet.")
+      .def_readwrite("grading", &CaseSpec::grading, "C5n, C5b or a grading CSV file.")
+      .def_readwrite("model", &CaseSpec::model, "GrainModel.")
+      .def_readwrite("wet", &CaseSpec::wet, "make_wet at the end of genesis (hill only).")
+      .def_property_readonly("name", &CaseSpec::name, "The case's name, e.g. C5b_Hill_wet.")
+      .def("__repr__", [](const CaseSpec& c) { return "CaseSpec('" + c.name() + "')"; }, "Its name.");
+  py::class_<StudySettings>(lab, "StudySettings", R"(Settings of study(): genesis, material, finalization, wetting, the
+triaxial test, output. Defaults are the headers' (the memo's full 170 mm x 240 mm vessel; the CLI's
+default is half that: genesis.vessel_radius = 0.0425, vessel_height = 0.120).)")
+      .def(py::init<>(), "The header's defaults.")
+      .def_readwrite("genesis", &StudySettings::genesis, "GenesisSpec (its grading is replaced by each case's).")
+      .def_readwrite("material", &StudySettings::material, "Class5Material (its model is replaced by each case's).")
+      .def_readwrite("test_walls", &StudySettings::test_walls, "WallContact after finalization.")
+      .def_readwrite("finalize", &StudySettings::finalize, "EquilibriumSettings after finalization and wetting (P_m).")
+      .def_readwrite("suction", &StudySettings::suction, "Suction of make_wet [Pa].")
+      .def_readwrite("moisture_gap", &StudySettings::moisture_gap, "Moisture gap g_m of make_wet [m].")
+      .def_readwrite("triaxial", &StudySettings::triaxial, "TriaxialSettings.")
+      .def_readwrite("pack_linear", &StudySettings::pack_linear, "Pack every material with linear contacts [bool].")
+      .def_readwrite("output_dir", &StudySettings::output_dir, "Folder the study writes into.")
+      .def_readwrite("specimen_file", &StudySettings::specimen_file, "Start from this packed specimen ('' : pack).")
+      .def_readwrite("save_specimens", &StudySettings::save_specimens, "Write the packed specimens [bool].")
+      .def_readwrite("jobs", &StudySettings::jobs, "Cases run at once (0: the number of cores).");
+
+  py::class_<Specimen>(lab, "Specimen", R"(A specimen in its vessel (genesis.hpp): the grains, the three walls and the
+genesis history. The drivers (finalize, make_wet, triaxial) change it in place: copy() first to keep it.)")
+      .def("copy", [](const Specimen& s) { return Specimen(s); }, "An independent copy.")
+      .def_readonly("grading", &Specimen::grading, "Grading name.")
+      .def_readonly("d_mult", &Specimen::d_mult, "D_mult [-].")
+      .def_readonly("seed", &Specimen::seed, "Seed of the cloud [-].")
+      .def_readonly("pressure", &Specimen::pressure, "Pressure P_m it was packed to [Pa].")
+      .def_readonly("material", &Specimen::material, "What the assignment table holds: 'packed', 'C5b_Hill', ...")
+      .def_readonly("packed_with", &Specimen::packed_with, "GrainModel of the packing contacts.")
+      .def_readonly("wet", &Specimen::wet, "Whether make_wet has run [bool].")
+      .def_property_readonly("grains", [](const Specimen& s) { return s.sim.balls.size(); }, "Grains [-].")
+      .def_property_readonly("phases", [](const Specimen& s) { return phase_list(s.phases); },
+                             "Genesis phases: [{'name', 'steps', 'seconds' [s], 'state', 'line'}].")
+      .def("diameters", &diameters, "Grain diameters [m] (numpy array, a copy).")
+      .def("state", [](const Specimen& s) { return state_dict(measure(s)); },
+           R"(The specimen now: {'grains', 'porosity', 'interior_porosity' [-], 'interior_margin' ('d_max', 'd50',
+'none'), 'interior_margin_length' [m], 'coordination', 'mech_coordination' [-], 'radial_stress',
+'bottom_stress', 'top_stress' [Pa], 'radius', 'height' [m], 'ratio' [-], 'wet_contacts', 'timestep' [s]}.)")
+      .def("simulation", &specimen_simulation,
+           "A hilldem.Simulation holding a copy of the specimen's state (views, contacts(), save_checkpoint).")
+      .def("save", [](const Specimen& s, const std::filesystem::path& path, const PackingSettings& p) {
+             save_packed_specimen(s, p, path.string());
+           },
+           py::arg("path"), py::arg("packing") = PackingSettings{},
+           R"(Write a packed (not finalized) specimen for load_specimen or `hilldem triaxial --specimen`; packing:
+the PackingSettings it was packed with (its contact and wall settings are recorded in the file).)");
+
+  lab.def("pack_specimen", [](const GenesisSpec& spec, bool log) {
+            validate(spec);
+            return released([&] { return pack_specimen(spec, log_stream(log)); });
+          },
+          py::arg("spec"), py::arg("log") = false,
+          R"(Genesis up to the packed, frictionless specimen (cloud, relaxation, servo packing to P_m): a
+Specimen. log: print the phases as the CLI does. RunError when a phase does not converge.)");
+  lab.def("load_specimen", [](const std::filesystem::path& path) {
+            PackingSettings p;
+            Specimen s = load_packed_specimen(path.string(), &p);
+            return py::make_tuple(std::move(s), p);
+          },
+          py::arg("path"), "A saved packed specimen: (Specimen, the PackingSettings stored with it).");
+  lab.def("finalize", [](Specimen& s, const Class5Material& m, const WallContact& w, const EquilibriumSettings& e, bool log) {
+            return phase_dict(released([&] { return finalize(s, m, w, e, log_stream(log)); }));
+          },
+          py::arg("specimen"), py::arg("material"), py::arg("walls") = WallContact{}, py::arg("equilibrium") = EquilibriumSettings{},
+          py::arg("log") = false,
+          "Install the material (friction restored) and bring the specimen to equilibrium at equilibrium.pressure [Pa]; the phase dict.");
+  lab.def("make_wet", [](Specimen& s, double suction, double gap, const EquilibriumSettings& e, bool log) {
+            return phase_dict(released([&] { return make_specimen_wet(s, suction, gap, e, log_stream(log)); }));
+          },
+          py::arg("specimen"), py::arg("suction"), py::arg("gap"), py::arg("equilibrium") = EquilibriumSettings{},
+          py::arg("log") = false,
+          "make_wet(suction [Pa], gap [m]) on a finalized hill specimen, then servo equilibrium; the phase dict.");
+  lab.def("servo_equilibrium", [](Specimen& s, const EquilibriumSettings& e, const std::string& name, bool log) {
+            return phase_dict(released([&] { return servo_equilibrium(s, e, name, log_stream(log)); }));
+          },
+          py::arg("specimen"), py::arg("equilibrium"), py::arg("name") = "equilibrium", py::arg("log") = false,
+          "Every wall to equilibrium.pressure [Pa] and static equilibrium; the phase dict.");
+  lab.def("triaxial", [](Specimen& s, const TriaxialSettings& t, bool log) {
+            validate(t);
+            return triaxial_dict(released([&] { return run_triaxial(s, t, log_stream(log)); }));
+          },
+          py::arg("specimen"), py::arg("settings"), py::arg("log") = false,
+          R"(The triaxial test on a finalized specimen. Returns {'history': {column: numpy array}, 'loops':
+[{...}], 'peak_q' [Pa], 'peak_strain' [-], 'height0', 'radius0' [m], 'worst_confinement_error',
+'worst_platen_mismatch' [-] (and the strains where they happened), 'steps', 'seconds' [s],
+'history_csv', 'loops_text'}. History columns: step, time [s], phase, cycle, eps_a, eps_r, eps_v [-],
+sigma_a, sigma_r, q, sigma_top, sigma_bottom [Pa], porosity, coordination, platen_mismatch [-].
+Loops: cycle, target_strain, eps_a, eps_b [-], q_a, q_b, q_c [Pa], closed, unload_secant (the
+resilient modulus M_r), reload_secant [Pa], loop_area [J/m^3], damping_ratio [-].)");
+  lab.def("memo_cases", &memo_cases, "The memo's five cases: C5n/C5b x linear/hill, plus C5b hill wet.");
+  lab.def("study", [](const StudySettings& s, const std::vector<CaseSpec>& cases, bool log) {
+            return study_dict(released([&] { return run_study(s, cases, log_stream(log)); }));
+          },
+          py::arg("settings"), py::arg("cases"), py::arg("log") = false,
+          R"(The study as `hilldem triaxial` runs it: per case genesis (or settings.specimen_file), finalization,
+wetting, confinement and the triaxial test, writing the CLI's files into settings.output_dir.
+Returns {'cases': [{'name', 'spec', 'grading' (grading_report), 'packed', 'initial' (states),
+'phases', 'test' (as triaxial()), 'seconds' [s], 'dir', ...}], 'seconds', 'cpu_seconds' [s],
+'summary_csv', 'summary_markdown', 'findings'}.)");
 }
 
 }  // namespace hilldem::python

@@ -1,5 +1,5 @@
-// hilldem.Simulation: building one (from TOML text or a file), cycling it in chunks with the GIL
-// released (callbacks, progress, Ctrl-C between chunks), the scenario's stages, wetting, settings and
+// hilldem.Simulation: building one (from TOML text or a file), cycling it with the GIL released
+// (callbacks, progress, Ctrl-C between cycles), the scenario's stages, wetting, settings and
 // checkpoints.
 #include <fmt/format.h>
 #include <pybind11/stl.h>
@@ -31,27 +31,69 @@ double seconds_now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-// A chunk of cycles runs without the GIL; between chunks Python runs: signals (Ctrl-C), the
-// callback, progress. Chunks grow until one takes kChunkSeconds, so Ctrl-C is answered within about
-// that and a long run pays the Python round trip a few times a second. How a run is cut into chunks
-// changes no result: each cycle() call continues exactly where the last stopped (test
+// C++ cycles without the GIL; Python runs between engine calls (the callback, progress) and, every
+// kPollSeconds, inside one: the engine asks StopHook before each cycle, and the hook then takes the
+// GIL and runs Python's signal handlers. An exception from one (Ctrl-C's KeyboardInterrupt) makes
+// the coming cycle the call's last, and is raised once the engine has returned, the simulation at
+// that cycle boundary. So a long cycle(n) is one engine call (each call rebuilds the cycle's
+// records and writes the contact results at its end: about one cycle's work), and Ctrl-C is
+// answered within about kPollSeconds. How a run is cut into calls changes no result (test
 // test_cycling.py::test_chunking_changes_no_bit).
-constexpr double kChunkSeconds = 0.05;    // [s]
-constexpr std::int64_t kMaxChunk = 1 << 20;  // [cycles]
+constexpr double kPollSeconds = 0.05;  // [s]
+
+class StopHook {
+ public:
+  // progress_seconds > 0: also end the engine call every that many seconds [s], for a progress line.
+  explicit StopHook(double progress_seconds = 0.0) : progress_(progress_seconds) {
+    const double now = seconds_now();
+    next_poll_ = now + kPollSeconds;
+    next_progress_ = now + progress_;
+  }
+  // Called by the engine (without the GIL) before each cycle: true ends the call after it.
+  bool operator()() {
+    const double now = seconds_now();
+    if (now < next_poll_) return false;
+    next_poll_ = now + kPollSeconds;
+    if (progress_ > 0.0 && now >= next_progress_) {
+      next_progress_ = now + progress_;
+      return true;
+    }
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() == 0) return false;
+    error_.emplace();  // takes the pending Python exception
+    return true;
+  }
+  // With the GIL: raise what a signal handler raised, if one did.
+  void rethrow() {
+    if (error_) {
+      py::error_already_set e = std::move(*error_);
+      error_.reset();
+      throw e;
+    }
+  }
+
+ private:
+  double progress_, next_poll_, next_progress_;
+  std::optional<py::error_already_set> error_;
+};
 
 void require_count(const char* what, const char* name, std::int64_t v, std::int64_t lo) {
   if (v < lo) throw InputError(fmt::format("{}: {} must be an integer >= {}; got {}", what, name, lo, v));
 }
 
-// step(k) runs at most k cycles, sets `ran` and returns true when the run is over (solve converged).
-// Returns the cycles run. every > 0: callback(sim) after every `every` cycles; a callback that
-// returns False ends the run there.
+// step(k, hook, ran) runs at most k cycles (asking hook between them, or running k cycles at most
+// and returning), sets `ran` and returns true when the run is over (solve converged). Returns the
+// cycles run. every > 0: callback(sim) after every `every` cycles; a callback that returns False
+// ends the run there. grow: the calls start at 1 cycle and double until one takes kPollSeconds
+// (for a step that does not ask the hook).
 template <class Step>
 std::int64_t run_chunked(py::object self, PySimulation& ps, const char* what, std::int64_t total,
-                         const py::object& callback, std::int64_t every, Progress* progress, Step&& step) {
+                         const py::object& callback, std::int64_t every, Progress* progress, double progress_seconds,
+                         bool grow, Step&& step) {
   ps.check_usable(what);
   ps.check_idle(what);
-  std::int64_t done = 0, chunk = 1;
+  StopHook hook(progress ? progress_seconds : 0.0);
+  std::int64_t done = 0, chunk = grow ? 1 : total;
   while (done < total) {
     std::int64_t k = std::min(total - done, chunk);
     if (every > 0) k = std::min(k, every - done % every);
@@ -61,12 +103,13 @@ std::int64_t run_chunked(py::object self, PySimulation& ps, const char* what, st
     {
       BusyScope busy(ps);
       py::gil_scoped_release release;
-      over = ps.stepping(what, [&] { return step(k, ran); });
+      over = ps.stepping(what, [&] { return step(k, hook, ran); });
     }
-    if (seconds_now() - t0 < kChunkSeconds && chunk < kMaxChunk) chunk *= 2;
+    if (grow && seconds_now() - t0 < kPollSeconds && chunk < (std::int64_t{1} << 20)) chunk *= 2;
     done += ran;
     if (progress) progress->tick(ps.sim(), done);
-    if (PyErr_CheckSignals() != 0) throw py::error_already_set();  // KeyboardInterrupt: the state is that after `done` cycles
+    hook.rethrow();  // KeyboardInterrupt: the state is that after `done` cycles
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
     if (every > 0 && !callback.is_none() && (done % every == 0 || over)) {
       const py::object r = callback(self);
       if (py::isinstance<py::bool_>(r) && !r.cast<bool>()) break;
@@ -107,11 +150,11 @@ std::int64_t cycle(py::object self, std::int64_t n, const py::object& callback, 
   require_count("cycle", "n", n, 0);
   check_every("cycle", callback, every);
   auto prog = make_progress(progress, "cycle", n, 0.0, 0);
-  return run_chunked(self, ps, "cycle", n, callback, every, prog ? &*prog : nullptr, [&](std::int64_t k, std::int64_t& ran) {
-    ps.sim().cycle(k);
-    ran = k;
-    return false;
-  });
+  return run_chunked(self, ps, "cycle", n, callback, every, prog ? &*prog : nullptr, progress, false,
+                     [&](std::int64_t k, StopHook& hook, std::int64_t& ran) {
+                       ran = ps.sim().cycle(k, std::ref(hook));
+                       return false;
+                     });
 }
 
 std::int64_t solve(py::object self, double ratio, std::int64_t max_steps, const py::object& callback, std::int64_t every,
@@ -124,7 +167,8 @@ std::int64_t solve(py::object self, double ratio, std::int64_t max_steps, const 
   auto prog = make_progress(progress, "solve", -1, ratio, max_steps);
   bool converged = false;
   const std::int64_t done =
-      run_chunked(self, ps, "solve", max_steps, callback, every, prog ? &*prog : nullptr, [&](std::int64_t k, std::int64_t& ran) {
+      run_chunked(self, ps, "solve", max_steps, callback, every, prog ? &*prog : nullptr, progress, true,
+                  [&](std::int64_t k, StopHook&, std::int64_t& ran) {
         const std::int64_t used = ps.sim().solve(ratio, k);
         converged = used >= 0;
         ran = converged ? used : k;
@@ -162,6 +206,8 @@ py::dict run_stages(PySimulation& ps, const std::optional<std::filesystem::path>
   opt.output_dir = output_dir ? output_dir->string() : "";
   opt.write_files = output_dir.has_value();
   opt.progress = quiet ? ProgressMode::Off : ProgressMode::Auto;
+  StopHook hook;  // Ctrl-C: the run ends at a cycle boundary (no stage-end outputs)
+  opt.stop_requested = std::ref(hook);
   std::ostringstream log;
   RunResult res;
   {
@@ -169,6 +215,7 @@ py::dict run_stages(PySimulation& ps, const std::optional<std::filesystem::path>
     py::gil_scoped_release release;
     res = ps.stepping("run_stages", [&] { return run_scenario(ps.scenario(), opt, log); });
   }
+  hook.rethrow();
   py::dict probes;
   for (const ProbeValue& p : res.probes) {
     py::dict d;
@@ -242,9 +289,9 @@ hilldem.load_checkpoint(path). Units are SI throughout (docs/python.md).)");
            py::arg("progress") = 0.0,
            R"(Run n cycles; returns the cycles run. callback(sim) runs after every `every` cycles
 (returning False stops the run there); progress: seconds between progress lines on stderr (0: none;
-True: every second). The GIL is
-released while C++ cycles; Ctrl-C raises KeyboardInterrupt between chunks of cycles, the
-simulation left at a cycle boundary (sim.steps says which).)")
+True: every second). The GIL is released while C++ cycles, in one engine call unless a callback
+or progress asks for more; Ctrl-C raises KeyboardInterrupt within about 0.05 s, the simulation left
+at a cycle boundary (sim.steps says which).)")
       .def("solve", &solve, py::arg("ratio"), py::arg("max_steps"), py::arg("callback") = py::none(),
            py::arg("every") = 0, py::arg("progress") = 0.0,
            R"(Cycle (at least once) until the mean unbalanced-force ratio [-] is <= ratio; returns the
@@ -272,7 +319,8 @@ their hill contacts, each made wet. Returns the number of wet contacts.)")
            },
            "Dry every hill contact; returns how many were wet.")
       .def("run_stages", &run_stages, py::arg("output_dir") = py::none(), py::arg("quiet") = true,
-           R"(Run the scenario's stages (as `hilldem run`). Returns {'probes': {label: {'value', 'unit',
+           R"(Run the scenario's stages (as `hilldem run`). Ctrl-C raises KeyboardInterrupt with the simulation at the
+cycle boundary where it stopped (no stage-end outputs are written; sim.steps says where). Returns {'probes': {label: {'value', 'unit',
 'quantity', 'target'}}, 'log': text, 'history_path': str, 'last_checkpoint': str}. Files (history,
 snapshots, checkpoints) are written only when output_dir is given.)")
       .def("save_checkpoint", [](PySimulation& ps, const std::filesystem::path& path) {

@@ -8,6 +8,7 @@
 
 #include "hilldem/io/runner.hpp"
 #include "hilldem/io/scenario.hpp"
+#include "hilldem/io/state_io.hpp"
 #include "sim_builders.hpp"
 
 namespace hilldem {
@@ -281,6 +282,29 @@ TEST(Determinism, TwoRunsAreBitwiseIdentical) {
   const auto a = run(), b = run();
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t i = 0; i < a.size(); ++i) EXPECT_TRUE(a[i] == b[i]) << "ball " << i;
+}
+
+// cycle(n, stop): once stop() says so, the coming cycle is the last; the state is bitwise cycle(k)'s,
+// contact results included, and cycling on continues as an uninterrupted run.
+TEST(Cycle, StoppedByTheHookIsTheStateOfThatManyCycles) {
+  auto make = [] {
+    Simulation sim = random_box(200, 3);
+    sim.settings.gravity = {0, 0, -9.81};
+    sim.settings.local_damping = 0.7;
+    sim.make_wet(20e3, 1e-3);
+    return sim;
+  };
+  Simulation hooked = make(), plain = make();
+  int asked = 0;
+  const std::int64_t ran = hooked.cycle(1000, [&] { return ++asked == 37; });
+  EXPECT_EQ(ran, 37);
+  EXPECT_EQ(hooked.steps, 37);
+  plain.cycle(37);
+  EXPECT_EQ(state_digest(hooked), state_digest(plain));
+  EXPECT_EQ(state_difference(hooked, plain), "");
+  EXPECT_EQ(hooked.cycle(25, [] { return false; }), 25);
+  plain.cycle(25);
+  EXPECT_EQ(state_difference(hooked, plain), "");
 }
 
 }  // namespace

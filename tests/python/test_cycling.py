@@ -36,7 +36,7 @@ def test_solve_returns_cycles_or_raises(assembly):
     assembly.cycle(5)  # not converging is no failure: the run goes on
 
 
-def test_ctrl_c_stops_between_chunks(assembly):
+def test_ctrl_c_stops_between_cycles(assembly, source_dir):
     timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
     timer.start()
     start = time.monotonic()
@@ -45,6 +45,10 @@ def test_ctrl_c_stops_between_chunks(assembly):
     assert time.monotonic() - start < 5.0
     steps = assembly.steps
     assert 0 < steps < 10**9
+    # One engine call, stopped by the interrupt: the state of cycle(steps), to the bit.
+    fresh = hilldem.load_scenario(source_dir / "examples" / "assembly_27.toml")
+    fresh.cycle(steps)
+    assert assembly.state_difference(fresh) == ""
     assembly.cycle(10)  # the simulation stopped at a cycle boundary and goes on
     assert assembly.steps == steps + 10
 
@@ -92,3 +96,24 @@ def test_the_bench_bed_from_python_is_the_clis(source_dir, cli):
     for _ in range(20):
         bed.cycle(1)
     assert bed.state_digest() == digest
+
+
+def test_ctrl_c_stops_the_stages_between_cycles(source_dir):
+    """A scenario's stages run from Python (run_stages) answer Ctrl-C too: KeyboardInterrupt within
+    about 0.05 s, the simulation at a cycle boundary, ready to go on."""
+    text = (source_dir / "examples" / "assembly_27.toml").read_text()
+    text = text[:text.index("[[stage]]")] + '[[stage]]\nname = "long"\ntype = "cycle"\nsteps = 1000000000\n'
+    sim = hilldem.scenario_from_text(text, "long.toml")
+    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    start = time.monotonic()
+    with pytest.raises(KeyboardInterrupt):
+        sim.run_stages()
+    assert time.monotonic() - start < 5.0
+    steps = sim.steps
+    assert 0 < steps < 10**9
+    fresh = hilldem.scenario_from_text(text, "long.toml")
+    fresh.cycle(steps)
+    assert sim.state_difference(fresh) == ""  # stopped cleanly, at a cycle boundary
+    sim.cycle(10)
+    assert sim.steps == steps + 10 and sim.failure == ""

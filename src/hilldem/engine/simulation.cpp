@@ -17,13 +17,21 @@
 namespace hilldem {
 
 
-void Simulation::cycle(std::int64_t n) {
+void Simulation::cycle(std::int64_t n) { cycle(n, {}); }
+
+std::int64_t Simulation::cycle(std::int64_t n, const std::function<bool()>& stop) {
   drop_records();  // the caller may have changed the columns since the last call
   for (std::int64_t k = 0; k < n; ++k) {
-    steps_ahead_ = n - 1 - k;  // (whether the live records pay: force_pass)
-    step_once(k + 1 == n);
+    const bool last = k + 1 == n || (stop && stop());
+    steps_ahead_ = last ? 0 : n - 1 - k;  // (whether the live records pay: force_pass)
+    step_once(last);
+    if (last) {
+      steps_ahead_ = 0;
+      return k + 1;
+    }
   }
   steps_ahead_ = 0;
+  return n;
 }
 
 std::int64_t Simulation::solve(double ratio, std::int64_t max_steps) {

@@ -62,6 +62,11 @@ class Simulation {
   // the balls' force sums do not read these columns, so results do not depend on it (test
   // ContactResults.WrittenOnTheLastCycleAndForObservers).
   void cycle(std::int64_t n);
+  // The same, asking stop() before each cycle: once it returns true, that cycle is the last one
+  // (its results written, as at the end of cycle(k)). Returns the cycles run, k ≤ n; the state is
+  // bitwise that of cycle(k), so a caller can answer an interruption (the Python module: Ctrl-C)
+  // without cutting a long run into many calls, each of which rebuilds the cycle's records.
+  std::int64_t cycle(std::int64_t n, const std::function<bool()>& stop);
   // Cycle (at least once) until the mean unbalanced-force ratio is ≤ ratio; returns the cycles
   // used, or -1 if max_steps passed first. (Every cycle's contact results are written.)
   std::int64_t solve(double ratio, std::int64_t max_steps);

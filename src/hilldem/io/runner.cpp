@@ -213,7 +213,7 @@ struct Position {
   std::vector<FixityMask> saved_fixity;  // translate/rotate: the fixity to restore at the end
 };
 
-struct Halted {};  // RunOptions::halt_after_step reached
+struct Halted {};  // RunOptions::halt_after_step reached or stop_requested() said so
 
 std::string stage_head(const Scenario& sc, std::size_t k) {
   const Stage& s = sc.stages[k];
@@ -571,6 +571,7 @@ class Runner {
     }
     fault_injection().on_step(sim_.steps);
     if (opt_.halt_after_step >= 0 && sim_.steps >= opt_.halt_after_step) throw Halted{};
+    if (opt_.stop_requested && opt_.stop_requested()) throw Halted{};
   }
 
   void run_motion(const Stage& s) {

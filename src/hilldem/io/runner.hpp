@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <iosfwd>
 #include <optional>
 #include <string>
@@ -41,6 +42,10 @@ struct RunOptions {
   // Tests: stop right after this step as if the process had died there (no stage-end outputs, no
   // final checkpoint); RunResult::halted says it happened. -1: never.
   std::int64_t halt_after_step = -1;
+  // Asked after every cycle whether to stop there (the Python module's run_stages answers Ctrl-C
+  // with it): when it returns true the run ends at that cycle boundary as at halt_after_step
+  // (RunResult::halted; no stage-end outputs). Empty: never asked.
+  std::function<bool()> stop_requested;
 };
 
 struct RunResult {
