@@ -3,6 +3,7 @@
 add_executable(hilldem_t307_tests
   labtests/test_t307_sequences.cpp
   labtests/test_universal_model.cpp
+  labtests/test_t307.cpp
 )
 target_link_libraries(hilldem_t307_tests PRIVATE hilldem::core GTest::gtest_main)
 target_compile_definitions(hilldem_t307_tests PRIVATE HILLDEM_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
