@@ -81,6 +81,18 @@ TEST(T307Driver, StopsAtThePermanentStrainLimit) {
   EXPECT_FALSE(r.fitted);
 }
 
+TEST(T307Driver, StopsInTheConditioningToo) {
+  Specimen s = testing::mini_packed();
+  finalize(s, Class5Material{}, WallContact{}, EquilibriumSettings{}, nullptr);
+  T307Settings t = mini_settings();
+  t.max_permanent_strain = 1e-6;
+  const T307Result r = run_t307(s, t, nullptr);
+  EXPECT_TRUE(r.stopped);
+  EXPECT_NE(r.stop_reason.find("sequence 0, cycle 1"), std::string::npos) << r.stop_reason;
+  ASSERT_EQ(r.rows.size(), 1u);
+  EXPECT_EQ(r.rows[0].nominal.number, 0);
+}
+
 TEST(T307Driver, RefusesBadSettingsBeforeAnyWork) {
   Specimen s = testing::mini_packed();
   T307Settings t = mini_settings();

@@ -123,10 +123,12 @@ T307Result run_t307(Specimen& s, const T307Settings& t, std::ostream* log) {
       // Peak compensation: the next command scaled by target / measured, within [0.5, 3] × the target.
       if (amplitude > 0) gain = std::clamp(gain * seq.cyclic / amplitude, 0.5, 3.0);
       res.cycles.push_back(cy);
-      if (seq.number != 0 && !std::isnan(eps_first) && cy.eps_a_end - eps_first > t.max_permanent_strain) {
+      // The standard's stop, in the conditioning (from its start) as in the sequences (from the first one's).
+      const double eps_ref = std::isnan(eps_first) ? eps_start : eps_first;
+      if (cy.eps_a_end - eps_ref > t.max_permanent_strain) {
         res.stopped = true;
         res.stop_reason = fmt::format("total permanent axial strain {:.3g} % passed the limit {:g} % in sequence {}, cycle {}",
-                                      100 * (cy.eps_a_end - eps_first), 100 * t.max_permanent_strain, seq.number, c);
+                                      100 * (cy.eps_a_end - eps_ref), 100 * t.max_permanent_strain, seq.number, c);
         row.cycles = c;
         break;
       }
