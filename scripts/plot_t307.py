@@ -7,8 +7,8 @@
 Reads each OUTPUT_DIR/t307_sequences.csv (and t307_fit.csv when the fit was made); writes
 t307_mr_theta.png into the first OUTPUT_DIR (or FILE): M_r [MPa] against theta [kPa], one marker
 per sequence, coloured by the confining pressure sigma3; the fitted model as a line through each
-sigma3 group (theta = 3 sigma3 + sigma_d, tau_oct = sqrt(2)/3 sigma_d, sigma_d from 0 to the
-group's largest). Several folders (e.g. dry and wet) share the axes, one marker shape each.
+sigma3 group (theta = 3 sigma3 + sigma_d, tau_oct = sqrt(2)/3 sigma_d, sigma_d from half the
+group's smallest sigma_max to its largest). Several folders (e.g. dry and wet) share the axes, one marker shape each.
 Needs matplotlib (Debian: python3-matplotlib).
 """
 import csv
@@ -61,10 +61,11 @@ def main(argv):
         if fit:
             k1, k2, k3 = (float(fit[k]) for k in ("k1[-]", "k2[-]", "k3[-]"))
             for s3 in sorted({round(float(r["sigma3[Pa]"])) for r in rows}):
-                smax = max(float(r["sigma_max[Pa]"]) for r in rows if round(float(r["sigma3[Pa]"])) == s3)
+                group = [float(r["sigma_max[Pa]"]) for r in rows if round(float(r["sigma3[Pa]"])) == s3]
+                lo, hi = 0.5 * min(group), max(group)
                 xs, ys = [], []
                 for j in range(41):
-                    sd = smax * j / 40
+                    sd = lo + (hi - lo) * j / 40
                     theta, tau = 3 * s3 + sd, math.sqrt(2) / 3 * sd
                     xs.append(theta / 1e3)
                     ys.append(k1 * P_A * (theta / P_A) ** k2 * (tau / P_A + 1) ** k3 / 1e6)
