@@ -174,7 +174,7 @@ Command add_t307_command(CLI::App& app) {
   cmd->add_option("--grading", o->grading, "C5n, C5b, or a grading CSV file (default C5b, or the --specimen's grading)");
   cmd->add_option("--material", o->material, "grain-grain model: linear or hill (default hill)");
   cmd->add_flag("--wet", o->wet, "make_wet(suction, moisture gap) after finalization (hill only)");
-  cmd->add_option("--specimen", o->specimen, "start from a saved packed specimen (the file `hilldem triaxial --pack-only` writes)");
+  cmd->add_option("--specimen", o->specimen, "start from a saved packed specimen (<output>/specimens/*_packed.csv of `hilldem t307` or `hilldem triaxial --pack-only`)");
   cmd->add_option("-o,--output", o->output, "output folder (default out/t307)");
   cmd->add_option("--scale", o->scale, "vessel size relative to the memo's 170 mm x 240 mm, in (0, 4] (default 0.3)");
   cmd->add_option("--seed", o->seed, "random seed of the grain cloud (default 10000)");
