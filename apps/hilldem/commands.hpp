@@ -22,5 +22,6 @@ Command add_resume_command(CLI::App& app);   // continue a run from a checkpoint
 Command add_inspect_command(CLI::App& app);  // describe a checkpoint
 Command add_run_output_options(CLI::App& app);  // snapshot/checkpoint options of `run` (after add_scenario_commands)
 Command add_triaxial_command(CLI::App& app);  // material genesis and triaxial tests (labtests/)
+Command add_t307_command(CLI::App& app);  // AASHTO T 307 resilient modulus (labtests/t307)
 
 }  // namespace hilldem::cli

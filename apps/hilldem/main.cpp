@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   commands.push_back(add_inspect_command(app));
   commands.push_back(add_run_output_options(app));
   commands.push_back(add_triaxial_command(app));
+  commands.push_back(add_t307_command(app));
 
   try {
     app.parse(argc, argv);
