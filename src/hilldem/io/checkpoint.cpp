@@ -3,7 +3,10 @@
 #include <array>
 #include <bit>
 #include <cerrno>
+#include <chrono>
 #include <fcntl.h>
+#include <ostream>
+#include <sys/stat.h>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -46,6 +49,39 @@ T get_at(const std::string& in, std::size_t offset) {
 
 std::string errno_text() { return std::strerror(errno); }
 
+std::ostream* g_io_log = nullptr;
+
+// Lines on g_io_log for a read or write of at least kLargeStateBytes: when it starts, every ~5 s,
+// and when it ends, with the size [MB] and the time taken [s].
+class LargeIoReport {
+ public:
+  LargeIoReport(const char* verb, const std::string& path, std::size_t total)
+      : verb_(verb), path_(path), total_(total), on_(g_io_log && total >= kLargeStateBytes) {
+    if (on_) *g_io_log << "checkpoint: " << verb_ << " " << path_ << " (" << mb(total_) << " MB)\n" << std::flush;
+  }
+  void at(std::size_t done) {
+    if (!on_) return;
+    const double t = seconds();
+    if (done < total_ && t - last_ < 5.0) return;
+    last_ = t;
+    if (done < total_)
+      *g_io_log << "checkpoint: " << verb_ << " " << path_ << ": " << mb(done) << " of " << mb(total_) << " MB (" << t << " s)\n"
+                << std::flush;
+    else
+      *g_io_log << "checkpoint: " << verb_ << " " << path_ << ": done, " << mb(total_) << " MB in " << t << " s\n" << std::flush;
+  }
+
+ private:
+  static long long mb(std::size_t b) { return static_cast<long long>(b >> 20); }
+  double seconds() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count(); }
+  const char* verb_;
+  std::string path_;
+  std::size_t total_;
+  bool on_;
+  std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();
+  double last_ = 0.0;
+};
+
 void write_atomically(const std::string& path, std::string_view bytes, bool checkpoint, bool durable);
 
 }  // namespace
@@ -57,6 +93,8 @@ std::uint32_t crc32(const void* data, std::size_t size, std::uint32_t crc) {
   for (std::size_t i = 0; i < size; ++i) crc = table[(crc ^ p[i]) & 0xFFu] ^ (crc >> 8);
   return ~crc;
 }
+
+void set_state_io_log(std::ostream* out) { g_io_log = out; }
 
 // ---- SectionReader ----
 
@@ -121,7 +159,17 @@ std::string CheckpointWriter::bytes() const {
   return out;
 }
 
-void CheckpointWriter::write_file(const std::string& path) const { write_atomically(path, bytes(), true, true); }
+void CheckpointWriter::write_file(const std::string& path) const {
+  std::size_t total = 0;
+  for (const Section& s : sections_) total += s.data.bytes().size() + s.name.size() + 20;
+  std::string all;
+  try {
+    all = bytes();
+  } catch (const std::bad_alloc&) {
+    throw OutOfMemory("assembling the checkpoint " + path, static_cast<double>(total));
+  }
+  write_atomically(path, all, true, true);
+}
 
 void write_file_atomically(const std::string& path, std::string_view bytes, bool durable) {
   write_atomically(path, bytes, false, durable);
@@ -149,8 +197,10 @@ void write_atomically(const std::string& path, std::string_view bytes, bool chec
   const fs::path tmp = target.string() + ".tmp." + std::to_string(::getpid());
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) throw RunError(tmp.string() + ": cannot create: " + errno_text());
+  LargeIoReport report("writing", path, bytes.size());
   const std::size_t half = bytes.size() / 2;
   write_all(fd, bytes.data(), half, tmp.string());
+  report.at(half);
   // Fault injection (tests only): die by SIGKILL with the temporary file half written.
   if (checkpoint) fault_injection().on_checkpoint_half_written();
   write_all(fd, bytes.data() + half, bytes.size() - half, tmp.string());
@@ -169,6 +219,7 @@ void write_atomically(const std::string& path, std::string_view bytes, bool chec
     ::unlink(tmp.c_str());
     throw RunError(target.string() + ": rename from the temporary file failed: " + why);
   }
+  report.at(bytes.size());
   if (!durable) return;
   // The rename is durable only once the folder entry is on disk.
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
@@ -184,14 +235,49 @@ void write_atomically(const std::string& path, std::string_view bytes, bool chec
 // ---- CheckpointReader ----
 
 CheckpointReader CheckpointReader::from_file(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw InputError(path + ": is a folder, not a checkpoint file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open the checkpoint file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) throw InputError(path + ": cannot read the checkpoint file");
-  return from_bytes(std::move(ss).str(), path);
+  // stat before opening: a FIFO would block the open, a device (/dev/zero) would read forever.
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) throw InputError(path + ": cannot open the checkpoint file: " + errno_text());
+  if (S_ISDIR(st.st_mode)) throw InputError(path + ": is a folder, not a checkpoint file");
+  if (!S_ISREG(st.st_mode))
+    throw InputError(path + ": is not a regular file (" +
+                     (S_ISFIFO(st.st_mode) ? "a FIFO" : S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "a device" : "a special file") +
+                     "), not a checkpoint file");
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+  if (fd < 0) throw InputError(path + ": cannot open the checkpoint file: " + errno_text());
+  struct FdCloser {
+    int fd;
+    ~FdCloser() { ::close(fd); }
+  } closer{fd};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) throw InputError(path + ": is not a regular file, not a checkpoint file");
+  const auto size = static_cast<std::size_t>(st.st_size);
+  auto read_exactly = [&](char* into, std::size_t n, std::size_t at) {
+    std::size_t done = 0;
+    while (done < n) {
+      const ssize_t got = ::pread(fd, into + done, n - done, static_cast<off_t>(at + done));
+      if (got < 0 && errno == EINTR) continue;
+      if (got < 0) throw InputError(path + ": cannot read the checkpoint file: " + errno_text());
+      if (got == 0) throw InputError(path + ": the checkpoint file shrank while it was read");
+      done += static_cast<std::size_t>(got);
+    }
+  };
+  // The magic first: a foreign file is refused without reading it whole.
+  std::string bytes(std::min(size, sizeof kMagic), '\0');
+  read_exactly(bytes.data(), bytes.size(), 0);
+  if (bytes.size() == sizeof kMagic && std::memcmp(bytes.data(), kMagic, sizeof kMagic) == 0 && size > sizeof kMagic) {
+    LargeIoReport report("reading", path, size);
+    try {
+      bytes.resize(size);
+    } catch (const std::bad_alloc&) {
+      throw OutOfMemory("reading the checkpoint " + path, static_cast<double>(size));
+    }
+    constexpr std::size_t kChunk = std::size_t{64} << 20;
+    for (std::size_t at = sizeof kMagic; at < size; at += kChunk) {
+      read_exactly(bytes.data() + at, std::min(kChunk, size - at), at);
+      report.at(at + std::min(kChunk, size - at));
+    }
+  }
+  return from_bytes(std::move(bytes), path);
 }
 
 CheckpointReader CheckpointReader::from_bytes(std::string bytes, const std::string& source) {

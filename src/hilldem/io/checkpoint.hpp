@@ -18,6 +18,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <iosfwd>
 #include <string>
 #include <string_view>
 #include <type_traits>
@@ -29,6 +30,11 @@
 namespace hilldem {
 
 inline constexpr std::uint32_t kCheckpointFormatVersion = 1;
+
+// Reads and writes of checkpoint files of at least this size report on the stream given to
+// set_state_io_log (start, every ~5 s, end with the time taken); none when it is null (the default).
+inline constexpr std::size_t kLargeStateBytes = std::size_t{100} << 20;
+void set_state_io_log(std::ostream* out);
 
 // CRC-32 (IEEE 802.3, as zlib), continuing from `crc` (0 to start).
 std::uint32_t crc32(const void* data, std::size_t size, std::uint32_t crc = 0);

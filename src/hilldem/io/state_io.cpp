@@ -657,4 +657,13 @@ std::string state_difference(const Simulation& a, const Simulation& b) {
   return "";
 }
 
+double state_memory_estimate(std::size_t balls, std::size_t rows) {
+  std::size_t per_ball = 0, per_row = 0;
+  BallStore b;
+  b.for_each_column([&](auto& c) { per_ball += sizeof(typename std::decay_t<decltype(c)>::value_type); });
+  ContactStore c;
+  ContactStore::zip_columns(c, c, [&](auto& col, auto&) { per_row += sizeof(typename std::decay_t<decltype(col)>::value_type); });
+  return 2.0 * (static_cast<double>(balls) * static_cast<double>(per_ball) + static_cast<double>(rows) * static_cast<double>(per_row));
+}
+
 }  // namespace hilldem
