@@ -194,10 +194,10 @@ Command add_triaxial_command(CLI::App& app) {
   cmd->add_option("--scale", o->scale, "vessel size relative to the memo's 170 mm x 240 mm (default 0.5)")->check(finite_number());
   cmd->add_option("--seed", o->seed, "random seed of the grain cloud (default 10000, Table 7)");
   cmd->add_option("--packing-pressure", o->packing_pressure,
-                  "packing pressure P_m [Pa]: packing, finalization and wetting (default 150e3, Table 7)")->check(finite_number());
+                  "packing pressure P_m [Pa]: packing, finalization and wetting (default 150e3, Table 7)");
   cmd->add_option("--confinement", o->confinement,
                   "confining pressure sigma_c of the triaxial test [Pa] (default 150e3); when it differs from P_m the "
-                  "specimen is first brought to it on every wall")->check(finite_number());
+                  "specimen is first brought to it on every wall");
   cmd->add_flag("--pack-linear", o->pack_linear,
                 "pack every material with frictionless linear contacts, one packing per grading (the former shared "
                 "packing; a deviation from the memo, which packs each material with its own model)");

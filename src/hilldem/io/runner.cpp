@@ -983,6 +983,18 @@ RunResult resume_scenario(const CheckpointReader& r, Scenario& sc, const RunOpti
 }
 
 RunResult resume_scenario(const std::string& path, Scenario& sc, const RunOptions& options, std::ostream& log) {
+  {
+    // A folder whose run is still going is refused before anything else is looked at.
+    std::error_code ec;
+    fs::path folder = fs::absolute(fs::path(path), ec).lexically_normal();
+    if (!folder.has_filename()) folder = folder.parent_path();  // "run/checkpoints/"
+    if (!fs::is_directory(folder, ec)) folder = folder.parent_path();
+    if (folder.filename() == kCheckpointFolder) folder = folder.parent_path();
+    const std::string who = OutputLock::holder(folder.string());
+    if (!who.empty())
+      throw InputError(folder.string() + ": the output folder is in use by another hilldem process (" + who +
+                       "); resume it when that process has ended");
+  }
   const std::string file = find_checkpoint(path, log);
   const CheckpointReader r = CheckpointReader::from_file(file);
   const fs::path parent = fs::absolute(fs::path(file)).parent_path();
