@@ -82,8 +82,6 @@ class LargeIoReport {
   double last_ = 0.0;
 };
 
-void write_atomically(const std::string& path, std::string_view bytes, bool checkpoint, bool durable);
-
 }  // namespace
 
 std::uint32_t crc32(const void* data, std::size_t size, std::uint32_t crc) {
@@ -138,41 +136,68 @@ SectionWriter& CheckpointWriter::section(const std::string& name, std::uint32_t 
   return sections_.back().data;
 }
 
-std::string CheckpointWriter::bytes() const {
-  std::string body;
-  for (const Section& s : sections_) {
-    const std::size_t start = body.size();
-    put<std::uint32_t>(body, static_cast<std::uint32_t>(s.name.size()));
-    body += s.name;
-    put<std::uint32_t>(body, s.version);
-    put<std::uint64_t>(body, s.data.bytes().size());
-    body += s.data.bytes();
-    put<std::uint32_t>(body, crc32(body.data() + start, body.size() - start));
+namespace {
+// A file's bytes as consecutive pieces (the sections' payloads are not copied into one string).
+using Pieces = std::vector<std::string_view>;
+void write_atomically(const std::string& path, const Pieces& pieces, bool checkpoint, bool durable);
+}  // namespace
+
+// The file as pieces: `frames` holds the header, each section's header and CRC and the trailer;
+// the pieces point into it and into the sections' payloads.
+static Pieces layout(const std::vector<CheckpointWriter::SectionView>& sections, std::vector<std::string>& frames) {
+  frames.clear();
+  frames.reserve(2 * sections.size() + 1);
+  std::uint64_t body = 0;
+  std::vector<std::size_t> head_of;
+  for (const auto& s : sections) {
+    std::string head;
+    put<std::uint32_t>(head, static_cast<std::uint32_t>(s.name->size()));
+    head += *s.name;
+    put<std::uint32_t>(head, s.version);
+    put<std::uint64_t>(head, s.payload->size());
+    std::string tail;
+    put<std::uint32_t>(tail, crc32(s.payload->data(), s.payload->size(), crc32(head.data(), head.size())));
+    body += head.size() + s.payload->size() + tail.size();
+    frames.push_back(std::move(head));
+    frames.push_back(std::move(tail));
   }
-  std::string out(kMagic, sizeof kMagic);
-  put<std::uint32_t>(out, kCheckpointFormatVersion);
-  put<std::uint32_t>(out, static_cast<std::uint32_t>(sections_.size()));
-  put<std::uint64_t>(out, body.size());
-  put<std::uint32_t>(out, crc32(out.data(), out.size()));
-  out += body;
-  out.append(kTrailer, sizeof kTrailer);
+  std::string header(kMagic, sizeof kMagic);
+  put<std::uint32_t>(header, kCheckpointFormatVersion);
+  put<std::uint32_t>(header, static_cast<std::uint32_t>(sections.size()));
+  put<std::uint64_t>(header, body);
+  put<std::uint32_t>(header, crc32(header.data(), header.size()));
+  frames.push_back(std::move(header));
+  Pieces out;
+  out.push_back(frames.back());
+  for (std::size_t k = 0; k < sections.size(); ++k) {
+    out.push_back(frames[2 * k]);
+    out.push_back(*sections[k].payload);
+    out.push_back(frames[2 * k + 1]);
+  }
+  out.push_back(std::string_view(kTrailer, sizeof kTrailer));
+  return out;
+}
+
+std::vector<CheckpointWriter::SectionView> CheckpointWriter::views() const {
+  std::vector<SectionView> v;
+  for (const Section& s : sections_) v.push_back({&s.name, s.version, &s.data.bytes()});
+  return v;
+}
+
+std::string CheckpointWriter::bytes() const {
+  std::vector<std::string> frames;
+  std::string out;
+  for (std::string_view p : layout(views(), frames)) out += p;
   return out;
 }
 
 void CheckpointWriter::write_file(const std::string& path) const {
-  std::size_t total = 0;
-  for (const Section& s : sections_) total += s.data.bytes().size() + s.name.size() + 20;
-  std::string all;
-  try {
-    all = bytes();
-  } catch (const std::bad_alloc&) {
-    throw OutOfMemory("assembling the checkpoint " + path, static_cast<double>(total));
-  }
-  write_atomically(path, all, true, true);
+  std::vector<std::string> frames;
+  write_atomically(path, layout(views(), frames), true, true);
 }
 
 void write_file_atomically(const std::string& path, std::string_view bytes, bool durable) {
-  write_atomically(path, bytes, false, durable);
+  write_atomically(path, Pieces{bytes}, false, durable);
 }
 
 namespace {
@@ -191,19 +216,31 @@ void write_all(int fd, const char* data, std::size_t size, const std::string& tm
   }
 }
 
-void write_atomically(const std::string& path, std::string_view bytes, bool checkpoint, bool durable) {
+void write_atomically(const std::string& path, const Pieces& pieces, bool checkpoint, bool durable) {
   namespace fs = std::filesystem;
   const fs::path target(path);
   const fs::path tmp = target.string() + ".tmp." + std::to_string(::getpid());
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) throw RunError(tmp.string() + ": cannot create: " + errno_text());
-  LargeIoReport report("writing", path, bytes.size());
-  const std::size_t half = bytes.size() / 2;
-  write_all(fd, bytes.data(), half, tmp.string());
-  report.at(half);
-  // Fault injection (tests only): die by SIGKILL with the temporary file half written.
-  if (checkpoint) fault_injection().on_checkpoint_half_written();
-  write_all(fd, bytes.data() + half, bytes.size() - half, tmp.string());
+  std::size_t total = 0;
+  for (std::string_view p : pieces) total += p.size();
+  LargeIoReport report("writing", path, total);
+  const std::size_t half = total / 2;
+  std::size_t done = 0;
+  constexpr std::size_t kChunk = std::size_t{64} << 20;
+  for (std::string_view p : pieces) {
+    for (std::size_t at = 0; at < p.size();) {
+      // Pieces are cut at the half (fault injection) and into chunks (progress lines).
+      std::size_t n = std::min(p.size() - at, kChunk);
+      if (done < half && done + n > half) n = half - done;
+      write_all(fd, p.data() + at, n, tmp.string());
+      at += n;
+      done += n;
+      report.at(done);
+      // Fault injection (tests only): die by SIGKILL with the temporary file half written.
+      if (checkpoint && done == half) fault_injection().on_checkpoint_half_written();
+    }
+  }
   if (durable && ::fsync(fd) != 0) {
     const std::string why = errno_text();
     ::close(fd);
@@ -219,7 +256,6 @@ void write_atomically(const std::string& path, std::string_view bytes, bool chec
     ::unlink(tmp.c_str());
     throw RunError(target.string() + ": rename from the temporary file failed: " + why);
   }
-  report.at(bytes.size());
   if (!durable) return;
   // The rename is durable only once the folder entry is on disk.
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");

@@ -133,10 +133,18 @@ class CheckpointWriter {
   SectionWriter& section(const std::string& name, std::uint32_t version = 1);
   // The whole file as bytes.
   std::string bytes() const;
-  // Atomic write to path (tmp file, fsync, rename, fsync of the folder). Throws RunError on I/O failure.
+  // Atomic write to path (tmp file, fsync, rename, fsync of the folder), streamed from the sections
+  // (the file is never assembled in memory). Throws RunError on I/O failure.
   void write_file(const std::string& path) const;
 
+  struct SectionView {
+    const std::string* name;
+    std::uint32_t version;
+    const std::string* payload;
+  };
+
  private:
+  std::vector<SectionView> views() const;
   struct Section {
     std::string name;
     std::uint32_t version;

@@ -589,9 +589,16 @@ class Runner {
     if (result_.checkpoint_dir.empty()) return;
     ++seq_;
     const std::string path = (fs::path(result_.checkpoint_dir) / fmt::format("ckpt-{:06}.hdc", seq_)).string();
-    CheckpointWriter w;
-    write_run_sections(w, kind, "");
-    w.write_file(path);
+    try {
+      CheckpointWriter w;
+      write_run_sections(w, kind, "");
+      w.write_file(path);
+    } catch (const std::bad_alloc&) {
+      progress_.clear();
+      throw OutOfMemory(fmt::format("writing the checkpoint {} ({} balls, {} neighbour rows)", path, sim_.balls.size(),
+                                    sim_.contacts.size()),
+                        state_memory_estimate(sim_.balls.size(), sim_.contacts.size()));
+    }
     result_.last_checkpoint = path;
     last_checkpoint_stage_ = pos_.stage;
     last_checkpoint_time_ = now_seconds();

@@ -633,10 +633,17 @@ std::string state_bytes(const Simulation& sim) {
 }
 
 std::string state_digest(const Simulation& sim) {
+  // FNV-1a over state_bytes, part by part (the same bytes in the same order, without concatenating them).
   std::uint64_t h = 1469598103934665603ull;
-  for (unsigned char ch : state_bytes(sim)) {
-    h ^= ch;
-    h *= 1099511628211ull;
+  auto mix = [&h](const std::string& bytes) {
+    for (unsigned char ch : bytes) {
+      h ^= ch;
+      h *= 1099511628211ull;
+    }
+  };
+  for (const Part& p : state_parts(sim)) {
+    mix(p.label);
+    mix(p.bytes);
   }
   return fmt::format("{:016x}", h);
 }
