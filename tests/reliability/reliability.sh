@@ -80,6 +80,30 @@ case_lock_two_runs() {
   same_outputs "$tmp/run"
 }
 
+# Item 4: a second signal stops at once. Two signals are made pending while the run is stopped
+# (SIGSTOP), so both arrive together when it continues: the first asks for the graceful stop, the
+# second kills the process by its default action (status 128 + the signal, no stop message, no new
+# checkpoint).
+case_second_signal() {
+  "$hilldem" run -q "$scenario" -o "$tmp/run" >/dev/null 2>"$tmp/run.err" &
+  held_pid=$!
+  # (The lock is taken after the handlers are installed.)
+  for _ in $(seq 1 2000); do grep -qs "pid $held_pid" "$tmp/run/.hilldem.lock" && break; sleep 0.005; done
+  kill -STOP "$held_pid" 2>/dev/null || fail "the run ended before the test could hold it"
+  for _ in $(seq 1 400); do grep -q '^State:.*T' "/proc/$held_pid/status" && break; sleep 0.005; done
+  local before
+  before="$(ls "$tmp/run/checkpoints")"
+  kill -TERM "$held_pid"
+  kill -INT "$held_pid"
+  kill -CONT "$held_pid"
+  wait "$held_pid"
+  local status=$?
+  held_pid=
+  [ "$status" -eq 130 ] || [ "$status" -eq 143 ] || fail "status $status, expected 130 or 143 (killed by the second signal)"
+  ! grep -q "stopped by" "$tmp/run.err" || fail "the second signal did not stop at once: $(cat "$tmp/run.err")"
+  [ "$(ls "$tmp/run/checkpoints" | grep -v '\.tmp\.')" = "$(echo "$before" | grep -v '\.tmp\.')" ] || fail "a checkpoint was written after the second signal"
+}
+
 # Item 2: resume refuses a history that is shorter, missing or changed, and a snapshot index that
 # lists files that are gone, instead of silently restarting them.
 case_resume_checks() {

@@ -2,7 +2,7 @@
 # graceful stop on signals, the stage-end checkpoint budget, input ranges, non-regular files and out
 # of memory (tests/reliability/reliability.sh, tests/cli/kill_and_resume.sh, tests/cli/expect_exit.sh).
 set(HILLDEM_RELIABILITY bash ${CMAKE_CURRENT_SOURCE_DIR}/reliability/reliability.sh $<TARGET_FILE:hilldem> ${HILLDEM_RESTART_BED})
-foreach(c lock_held lock_two_runs resume_checks resume_elsewhere torn_files stage_end_budget out_of_memory)
+foreach(c lock_held lock_two_runs second_signal resume_checks resume_elsewhere torn_files stage_end_budget out_of_memory)
   add_test(NAME reliability.${c} COMMAND ${HILLDEM_RELIABILITY} ${c})
   list(APPEND HILLDEM_RELIABILITY_TESTS reliability.${c})
 endforeach()

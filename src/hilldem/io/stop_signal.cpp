@@ -1,5 +1,6 @@
 #include "hilldem/io/stop_signal.hpp"
 
+#include <atomic>
 #include <csignal>
 #include <initializer_list>
 
@@ -7,16 +8,17 @@ namespace hilldem {
 
 namespace {
 
-volatile std::sig_atomic_t g_signal = 0;
+// A lock-free atomic rather than a plain sig_atomic_t: two signals may be handled at the same time
+// on two threads (OpenMP), and exactly one of them must be the first.
+std::atomic<int> g_signal{0};
+static_assert(std::atomic<int>::is_always_lock_free, "the stop flag must be async-signal-safe");
 
 extern "C" void on_stop_signal(int sig) {
-  if (g_signal != 0) {
-    // The second signal: stop now, with the status of a process killed by it.
-    std::signal(sig, SIG_DFL);
-    std::raise(sig);
-    return;
-  }
-  g_signal = sig;
+  int none = 0;
+  if (g_signal.compare_exchange_strong(none, sig)) return;  // the first: stop after this cycle
+  // The second signal: stop now, with the status of a process killed by it.
+  std::signal(sig, SIG_DFL);
+  std::raise(sig);
 }
 
 }  // namespace
@@ -29,7 +31,7 @@ void install_stop_handlers() {
   for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaction(sig, &sa, nullptr);
 }
 
-int stop_requested() { return g_signal; }
+int stop_requested() { return g_signal.load(std::memory_order_relaxed); }
 
 const char* signal_name(int sig) {
   switch (sig) {
