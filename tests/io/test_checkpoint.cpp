@@ -152,7 +152,12 @@ TEST(Checkpoint, EngineStateRoundTripsBitwise) {
   Simulation back;
   read_simulation(r, back, true);
   EXPECT_EQ(state_difference(sim, back), "");
-  EXPECT_EQ(back.contacts.size(), sim.contacts.size());  // neighbour rows too
+  // No periodic box: only the contacts are saved, the neighbour rows are found again by a rebuild at
+  // the first cycle (and cycling on is still bitwise, below).
+  std::size_t contacts = 0;
+  for (std::size_t c = 0; c < sim.contacts.size(); ++c) contacts += sim.contacts.exists[c];
+  ASSERT_LT(contacts, sim.contacts.size());
+  EXPECT_EQ(back.contacts.size(), contacts);
   // Cycling on from the restored state is cycling on from the original.
   Simulation original = sim;
   original.cycle(200);
@@ -205,7 +210,12 @@ TEST(Checkpoint, TrailingDataAndForeignFilesAreRefused) {
 
 // Contents that pass every checksum but are invalid are refused by the validation in read_simulation.
 TEST(Checkpoint, InvalidContentsWithValidChecksumsAreRefused) {
-  const Simulation good = assembly_state();
+  // Contacts only, so that every row mutated below is one that is saved.
+  Simulation good = assembly_state();
+  ContactStore rows;
+  for (std::size_t c = 0; c < good.contacts.size(); ++c)
+    if (good.contacts.exists[c]) rows.append_row(good.contacts, c);
+  good.contacts = rows;
   ASSERT_GT(good.contacts.size(), 2u);
   auto refused = [&](const char* what, auto&& mutate, const std::string& expect) {
     Simulation sim = good;
