@@ -22,6 +22,7 @@ Command add_inspect_command(CLI::App& app) {
   auto* ball = cmd->add_option("--ball", o->ball, "also list this ball (user id) and every contact it has");
   cmd->add_flag("--digest", o->digest, "print only the digest of the saved state (equal digests: bitwise-equal states)");
   return {cmd, [o, ball] {
+            set_state_io_log(&std::cerr);  // progress on reads of large states (stderr)
             if (o->digest) {
               const CheckpointReader r = CheckpointReader::from_file(o->file);
               Simulation sim;

@@ -1,10 +1,30 @@
 // hilldem resume DIR_OR_FILE: continue a run from its last checkpoint (io/runner.hpp).
 #include <iostream>
 
+#include <filesystem>
+#include <fmt/format.h>
+
 #include "commands.hpp"
+#include "hilldem/core/error.hpp"
+#include "hilldem/io/checkpoint.hpp"
 #include "hilldem/io/runner.hpp"
+#include "hilldem/io/stop_signal.hpp"
 
 namespace hilldem::cli {
+
+int report_stop(int signal, std::int64_t step, double time, const std::string& checkpoint, const std::string& checkpoint_dir) {
+  std::cout.flush();
+  if (checkpoint.empty())
+    std::cerr << fmt::format("hilldem: stopped by {} at step {} (t = {:.6g} s); no checkpoint written (checkpoints are "
+                             "off), so the run cannot be resumed\n",
+                             signal_name(signal), step, time);
+  else
+    std::cerr << fmt::format("hilldem: stopped by {} at step {} (t = {:.6g} s); checkpoint {}\n  continue with: hilldem "
+                             "resume {}\n",
+                             signal_name(signal), step, time, checkpoint,
+                             std::filesystem::path(checkpoint_dir).parent_path().string());
+  return 128 + signal;
+}
 
 Command add_resume_command(CLI::App& app) {
   struct Options {
@@ -17,15 +37,19 @@ Command add_resume_command(CLI::App& app) {
       "Continue a run from its newest intact checkpoint: give the run's output folder, its checkpoints/ folder or a "
       "checkpoint file. The result is bitwise that of an uninterrupted run.");
   cmd->add_option("path", o->path, "output folder, checkpoints/ folder or checkpoint file (.hdc)")->required();
-  cmd->add_option("-o,--output", o->output, "write the outputs here instead of the checkpoint's output folder");
+  CLI::Option* output = cmd->add_option("-o,--output", o->output, "write the outputs here instead of the checkpoint's output folder");
   cmd->add_flag("-q,--quiet", o->quiet, "no stage lines or progress");
-  return {cmd, [o] {
+  return {cmd, [o, output] {
+            if (output->count() > 0 && o->output.empty()) throw InputError("-o: the output folder name is empty");
+            if (!o->quiet) set_state_io_log(&std::cerr);
+            install_stop_handlers();
             RunOptions opt;
             opt.quiet = o->quiet;
             opt.output_dir = o->output;
             Scenario sc;
             if (!o->quiet) std::cout << "hilldem resume " << o->path << "\n";
             const RunResult res = resume_scenario(o->path, sc, opt, std::cout);
+            if (res.stopped_by) return report_stop(res.stopped_by, sc.sim.steps, sc.sim.time, res.last_checkpoint, res.checkpoint_dir);
             if (!o->quiet)
               std::cout << (res.already_complete ? "the run had already finished; nothing to do\n"
                                                  : "finished at step " + std::to_string(sc.sim.steps) +

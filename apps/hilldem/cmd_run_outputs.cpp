@@ -25,13 +25,13 @@ Command add_run_output_options(CLI::App& app) {
   run->add_option_function<double>(
          "--checkpoint-seconds", [&o](double s) { o.checkpoint_seconds = s; },
          "write a checkpoint every S seconds of wall-clock time (default 600; 0: not by time)")
-      ->check(CLI::Range(0.0, 1e9));
+      ->check(finite_range(0.0, 1e9, "s"));
   run->add_flag_function(
       "--no-checkpoints", [&o](std::int64_t) { o.no_checkpoints = true; }, "write no checkpoints");
   run->add_option_function<double>(
          "--blowup-fraction", [&o](double f) { o.blowup_fraction = f; },
          "stop when a free ball moves more than F times its radius in one step (default 0.5; 0: off)")
-      ->check(CLI::Range(0.0, 1e9));
+      ->check(finite_range(0.0, 1e9, "-"));
   return {nullptr, {}};
 }
 

@@ -4,6 +4,10 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "hilldem/core/error.hpp"
+#include "hilldem/io/checkpoint.hpp"
+#include "hilldem/io/output_folder.hpp"
+#include "hilldem/io/stop_signal.hpp"
 #include "hilldem/io/runner.hpp"
 #include "hilldem/io/scenario.hpp"
 
@@ -12,16 +16,31 @@ namespace hilldem::cli {
 namespace {
 struct Options {
   std::string file, output;
+  bool output_given = false;  // -o on the command line (an empty -o is refused, not "no folder")
   bool quiet = false;
 };
 
+// The output folder a run would write: refused (InputError, exit status 2) when it cannot be one.
+void check_output_folder(const std::string& file, const std::string& scenario_dir, const Options& o) {
+  if (o.output_given && o.output.empty()) throw InputError("-o: the output folder name is empty");
+  const std::string& dir = o.output_given ? o.output : scenario_dir;
+  if (dir.empty()) return;  // no [output] dir and no -o: the run writes no files
+  const std::string problem = output_folder_problem(dir);
+  if (!problem.empty())
+    throw InputError(o.output_given ? "-o: " + problem : file + ": key 'output.dir': " + problem);
+}
+
 int run(const Options& o) {
   Scenario sc = load_scenario_file(o.file);
+  check_output_folder(o.file, sc.output_dir, o);
   RunOptions opt;
   opt.quiet = o.quiet;
   opt.output_dir = o.output;
   if (!o.quiet) std::cout << "hilldem run " << o.file << (sc.title.empty() ? "" : ": " + sc.title) << "\n";
+  if (!o.quiet) set_state_io_log(&std::cerr);
+  install_stop_handlers();
   const RunResult res = run_scenario(sc, opt, std::cout);
+  if (res.stopped_by) return report_stop(res.stopped_by, sc.sim.steps, sc.sim.time, res.last_checkpoint, res.checkpoint_dir);
   if (!res.probes.empty()) {
     std::cout << fmt::format("{:<12} {:<26} {:<22} {:>16} {}\n", "label", "quantity", "target", "value", "unit");
     for (const auto& p : res.probes)
@@ -38,14 +57,18 @@ std::vector<Command> add_scenario_commands(CLI::App& app) {
 
   auto* run_cmd = app.add_subcommand("run", "Run a scenario file (TOML): its stages, histories and probes");
   run_cmd->add_option("file", o->file, "scenario file (.toml)")->required();
-  run_cmd->add_option("-o,--output", o->output, "output folder (overrides [output] dir)");
+  CLI::Option* output = run_cmd->add_option("-o,--output", o->output, "output folder (overrides [output] dir)");
   run_cmd->add_flag("-q,--quiet", o->quiet, "no progress lines");
-  out.push_back({run_cmd, [o] { return run(*o); }});
+  out.push_back({run_cmd, [o, output] {
+                   o->output_given = output->count() > 0;
+                   return run(*o);
+                 }});
 
   auto* check = app.add_subcommand("check", "Validate a scenario file without running it");
   check->add_option("file", o->file, "scenario file (.toml)")->required();
   out.push_back({check, [o] {
                    const ScenarioDescription sc = read_scenario_file(o->file);  // read and validated, not built
+                   check_output_folder(o->file, sc.output_dir, *o);
                    std::cout << fmt::format("{}: valid ({} balls, {} walls, {} assignment rules, {} stages, {} histories)\n",
                                             o->file, sc.sim.balls.size(), sc.sim.walls.size(),
                                             sc.sim.rules.size(), sc.stages.size(), sc.histories.size());

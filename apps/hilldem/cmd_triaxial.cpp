@@ -16,6 +16,7 @@
 
 #include "commands.hpp"
 #include "hilldem/core/error.hpp"
+#include "hilldem/io/output_folder.hpp"
 #include "hilldem/labtests/specimen_io.hpp"
 #include "hilldem/labtests/study.hpp"
 
@@ -135,6 +136,8 @@ std::string quote(const std::string& s) {
 
 int run(const Options& o) {
   auto [settings, cases] = build(o);  // throws InputError (exit 2) before anything is written
+  // The folder is this process's while it runs (io/output_folder.hpp); an unwritable one is bad input.
+  const OutputLock lock(settings.output_dir, "-o");
   if (o.threads > 0) omp_set_num_threads(o.threads);  // 0: OpenMP's default (OMP_NUM_THREADS or all cores)
   std::ostream* log = o.quiet ? nullptr : &std::cout;
   if (log)
@@ -188,7 +191,7 @@ Command add_triaxial_command(CLI::App& app) {
   cmd->add_flag("--wet", o->wet, "make_wet(suction, moisture gap) at the end of genesis (hill only)");
   cmd->add_option("-o,--output", o->output, "output folder (default out/triaxial, or out/study with --study)");
   cmd->add_flag("--full", o->full, "the memo's full 170 mm x 240 mm vessel (default: scaled by 0.5, 85 mm x 120 mm)");
-  cmd->add_option("--scale", o->scale, "vessel size relative to the memo's 170 mm x 240 mm (default 0.5)");
+  cmd->add_option("--scale", o->scale, "vessel size relative to the memo's 170 mm x 240 mm (default 0.5)")->check(finite_number());
   cmd->add_option("--seed", o->seed, "random seed of the grain cloud (default 10000, Table 7)");
   cmd->add_option("--packing-pressure", o->packing_pressure,
                   "packing pressure P_m [Pa]: packing, finalization and wetting (default 150e3, Table 7)");
@@ -199,18 +202,18 @@ Command add_triaxial_command(CLI::App& app) {
                 "pack every material with frictionless linear contacts, one packing per grading (the former shared "
                 "packing; a deviation from the memo, which packs each material with its own model)");
   cmd->add_option("--cycles", o->cycles, "axial strains [%] at which load-unload cycles reverse, increasing (default 0.02,0.05)")
-      ->delimiter(',');
-  cmd->add_option("--final-strain", o->final_strain, "final axial strain [%] (default 1)");
-  cmd->add_option("--strain-rate", o->strain_rate, "axial strain rate during the cycles [1/s] (default 0.02)");
-  cmd->add_option("--final-strain-rate", o->final_strain_rate, "axial strain rate after the cycles [1/s] (default 0.1)");
+      ->delimiter(',')->check(finite_number());
+  cmd->add_option("--final-strain", o->final_strain, "final axial strain [%] (default 1)")->check(finite_number());
+  cmd->add_option("--strain-rate", o->strain_rate, "axial strain rate during the cycles [1/s] (default 0.02)")->check(finite_number());
+  cmd->add_option("--final-strain-rate", o->final_strain_rate, "axial strain rate after the cycles [1/s] (default 0.1)")->check(finite_number());
   cmd->add_option("--density-scaling", o->density_scaling,
                   "triaxial tests with a fixed time step F times the automatic one and density scaling: F times "
-                  "fewer steps (0 = off, the default; or 1 to 50)");
-  cmd->add_option("--unload-to", o->unload_to, "unload until q falls to this fraction of q at the reversal (default 0.1)");
-  cmd->add_option("--suction", o->suction, "suction of make_wet [Pa] (default 20e3)");
-  cmd->add_option("--moisture-gap", o->moisture_gap, "moisture gap of make_wet [m] (default 3e-3)");
-  cmd->add_option("--d-mult", o->d_mult, "diameter multiplier D_mult (default 1)");
-  cmd->add_option("--finalize-ratio", o->finalize_ratio, "equilibrium ratio after finalization and wetting (default 8e-3)");
+                  "fewer steps (0 = off, the default; or 1 to 50)")->check(finite_number());
+  cmd->add_option("--unload-to", o->unload_to, "unload until q falls to this fraction of q at the reversal (default 0.1)")->check(finite_number());
+  cmd->add_option("--suction", o->suction, "suction of make_wet [Pa] (default 20e3)")->check(finite_number());
+  cmd->add_option("--moisture-gap", o->moisture_gap, "moisture gap of make_wet [m] (default 3e-3)")->check(finite_number());
+  cmd->add_option("--d-mult", o->d_mult, "diameter multiplier D_mult (default 1)")->check(finite_number());
+  cmd->add_option("--finalize-ratio", o->finalize_ratio, "equilibrium ratio after finalization and wetting (default 8e-3)")->check(finite_number());
   cmd->add_option("--specimen", o->specimen, "start from a saved packed specimen (out/.../specimens/<grading>_packed.csv)");
   cmd->add_flag("--pack-only", o->pack_only,
                 "genesis only: pack the specimen(s) and save them to <output>/specimens/ for later --specimen runs");

@@ -3,6 +3,8 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <cmath>
+#include <fmt/format.h>
 #include <functional>
 #include <memory>
 #include <vector>
@@ -13,6 +15,25 @@ struct Command {
   CLI::App* sub = nullptr;
   std::function<int()> run;  // returns the exit status
 };
+
+// A real option's range check, as the TOML keys have: NaN and inf are refused (CLI::Range lets NaN
+// through, since every comparison with NaN is false). The parse error exits with status 2.
+inline CLI::Validator finite_range(double lo, double hi, const std::string& unit) {
+  const std::string range = lo == -HUGE_VAL && hi == HUGE_VAL ? std::string("(-inf, inf)") : fmt::format("[{:g}, {:g}] {}", lo, hi, unit);
+  return CLI::Validator(
+      [lo, hi, range](std::string& text) -> std::string {
+        double v = 0.0;
+        if (!CLI::detail::lexical_cast(text, v)) return "must be a number in " + range + "; got \"" + text + "\"";
+        if (!std::isfinite(v) || v < lo || v > hi) return "must be a finite number in " + range + "; got " + text;
+        return "";
+      },
+      range);
+}
+inline CLI::Validator finite_number() { return finite_range(-HUGE_VAL, HUGE_VAL, ""); }
+
+// After a run that a signal stopped (RunResult::stopped_by): the message on stderr saying where it
+// stopped and how to resume; returns the exit status, 128 + the signal number. Defined in cmd_resume.cpp.
+int report_stop(int signal, std::int64_t step, double time, const std::string& checkpoint, const std::string& checkpoint_dir);
 
 // Options live as long as the app: each add_* keeps its state in a shared_ptr captured by `run`.
 std::vector<Command> add_scenario_commands(CLI::App& app);  // run, check, contacts, quantities

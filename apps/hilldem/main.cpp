@@ -40,6 +40,9 @@ int main(int argc, char** argv) {
   } catch (const hilldem::RunError& e) {
     std::cerr << "hilldem: run failed: " << e.what() << "\n";
     return 1;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "hilldem: error: out of memory (outside the phases that report their size)\n";
+    return 1;
   } catch (const std::exception& e) {
     std::cerr << "hilldem: error: " << e.what() << "\n";
     return 1;

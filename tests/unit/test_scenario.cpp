@@ -224,14 +224,14 @@ TEST(ScenarioUnknownKey, KeyOfAnotherModel) {
 
 TEST(ScenarioWrongType, StringForANumber) {
   const std::string m = input_error(replace("density = 2650", "density = \"heavy\""));
-  EXPECT_TRUE(Mentions(m, {kFile, "key 'material[1].density'", "(line 10)", "must be a number", "(0, inf)",
+  EXPECT_TRUE(Mentions(m, {kFile, "key 'material[1].density'", "(line 10)", "must be a number", "[0.001, 1e+06]",
                            "[kg/m^3]", "heavy"}));
 }
 
 TEST(ScenarioWrongType, TwoElementPosition) {
   const std::string m =
       input_error(replace("position = [0.0, 0.0, 9.99e-3]", "position = [0.0, 0.0]"));
-  EXPECT_TRUE(Mentions(m, {kFile, "key 'ball[2].position'", "an array of 3 numbers", "(-inf, inf)", "[m]",
+  EXPECT_TRUE(Mentions(m, {kFile, "key 'ball[2].position'", "an array of 3 numbers", "[-1e+06, 1e+06]", "[m]",
                            "0.0, 0.0 ]"}));
 }
 
@@ -303,18 +303,18 @@ TEST(ScenarioRange, LocalDampingInASetSimulationStage) {
 
 TEST(ScenarioRange, NegativeRadius) {
   const std::string m = input_error(replace("radius = 5e-3", "radius = -5e-3"));
-  EXPECT_TRUE(Mentions(m, {kFile, "key 'ball[1].radius'", "(0, inf)", "[m]", "; got "}));
+  EXPECT_TRUE(Mentions(m, {kFile, "key 'ball[1].radius'", "[1e-09, 1000]", "[m]", "; got "}));
   EXPECT_DOUBLE_EQ(given_number(m), -5e-3);
 }
 
 TEST(ScenarioRange, ZeroRadius) {
   const std::string m = input_error(replace("radius = 5e-3", "radius = 0"));
-  EXPECT_TRUE(Mentions(m, {kFile, "key 'ball[1].radius'", "(0, inf)", "got 0"}));
+  EXPECT_TRUE(Mentions(m, {kFile, "key 'ball[1].radius'", "[1e-09, 1000]", "got 0"}));
 }
 
 TEST(ScenarioRange, InfiniteRadius) {
   const std::string m = input_error(replace("radius = 5e-3", "radius = inf"));
-  EXPECT_TRUE(Mentions(m, {kFile, "key 'ball[1].radius'", "(0, inf)", "got inf"}));
+  EXPECT_TRUE(Mentions(m, {kFile, "key 'ball[1].radius'", "[1e-09, 1000]", "got inf"}));
 }
 
 TEST(ScenarioRange, StepsZero) {
@@ -628,6 +628,59 @@ TEST(ScenarioDescription, BuildSimulationFromDataWrittenInCode) {
   EXPECT_GE(sim.find_ball_wall(10, 0), 0);
   sim.cycle(2);
   EXPECT_EQ(sim.steps, 2);
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------------
+// Magnitudes that would make a run meaningless are refused when the file is read (issue 34 item 7):
+// at run time they surfaced as a "non-finite position" blow-up (exit status 1) or a cell-grid error
+// without file or key.
+
+namespace {
+
+TEST(ScenarioRanges, PositionBeyondAMillionMetresIsRefusedWithKeyAndRange) {
+  const std::string m = input_error(replace("position = [0.0, 0.0, 9.99e-3]", "position = [1e300, 0.0, 9.99e-3]"));
+  EXPECT_TRUE(Mentions(m, {kFile, "ball[2].position", "[-1e+06, 1e+06]", "[m]", "1e+300"}));
+  // The bound itself is allowed.
+  EXPECT_NO_THROW(load_scenario(replace("position = [0.0, 0.0, 9.99e-3]", "position = [1e6, 0.0, 9.99e-3]"), kFile));
+}
+
+TEST(ScenarioRanges, RadiusDensityAndGravityOutsideTheirRangesAreRefused) {
+  EXPECT_TRUE(Mentions(input_error(replace("radius = 5e-3", "radius = 1e-300")), {"ball[1].radius", "[1e-09, 1000]", "[m]"}));
+  EXPECT_TRUE(Mentions(input_error(replace("density = 2650", "density = 1e-300")),
+                       {"material[1].density", "[0.001, 1e+06]", "[kg/m^3]", "1e-300"}));
+  EXPECT_TRUE(Mentions(input_error(replace("gravity = [0.0, 0.0, -9.81]", "gravity = [0.0, 0.0, -1e300]")),
+                       {"simulation.gravity", "[-10000, 10000]", "[m/s^2]"}));
+  EXPECT_TRUE(Mentions(input_error(replace("point = [0.0, 0.0, -5e-3]", "point = [0.0, 0.0, -5e7]")), {"wall[1].point", "[m]"}));
+}
+
+TEST(ScenarioRanges, BallGridReachingPastTheBoundIsRefused) {
+  const std::string grid = R"([[ball_grid]]
+first_id = 100
+origin = [0.0, 0.0, 0.1]
+counts = [10, 1, 1]
+spacing = 2e5
+radius = 5e-3
+material = "granite"
+
+[[wall]])";
+  EXPECT_TRUE(Mentions(input_error(replace("[[wall]]", grid)), {"ball_grid[1].spacing", "far corner", "[-1e+06, 1e+06]"}));
+}
+
+TEST(ScenarioRanges, PeriodicBoxTooSmallForTheCellGridIsRefusedNamingTheKey) {
+  // 2 R_max + skin = 10 mm + 1 mm: a period must be at least 33 mm.
+  const std::string box = "[simulation]\nperiodic = [\"x\"]\nbox_min = [-0.015, -1, -1]\nbox_max = [0.015, 1, 1]\n";
+  const std::string m = input_error(replace("[simulation]\n", box));
+  EXPECT_TRUE(Mentions(m, {kFile, "simulation.box_max", "0.03 m long in x", "3 interaction lengths", "0.033 m"}));
+  EXPECT_NO_THROW(load_scenario(replace("[simulation]\n", "[simulation]\nperiodic = [\"x\"]\nbox_min = [-0.017, -1, -1]\nbox_max = [0.017, 1, 1]\n"), kFile));
+}
+
+TEST(ScenarioRanges, HistoryFileDotDotIsRefused) {
+  for (const char* name : {"..", ".", ".hilldem.lock"}) {
+    const std::string m = input_error(replace("[[history]]", std::string("[output]\nhistory_file = \"") + name + "\"\n\n[[history]]"));
+    EXPECT_TRUE(Mentions(m, {kFile, "output.history_file", "plain file name"})) << name;
+  }
 }
 
 }  // namespace

@@ -19,4 +19,16 @@ class RunError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Out of memory, caught where a phase begins or ends (std::bad_alloc): what was being allocated and
+// roughly how much, so that the user can size the machine or the job. Exit status 1.
+class OutOfMemory : public std::runtime_error {
+ public:
+  // "out of memory while <phase> (about <bytes> MB needed)"; bytes <= 0: size unknown.
+  OutOfMemory(const std::string& phase, double bytes)
+      : std::runtime_error("out of memory while " + phase +
+                           (bytes > 0 ? " (about " + std::to_string(static_cast<long long>(bytes / 1048576.0 + 0.5)) +
+                                            " MB needed)"
+                                      : std::string())) {}
+};
+
 }  // namespace hilldem

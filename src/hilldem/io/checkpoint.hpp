@@ -18,6 +18,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <iosfwd>
 #include <string>
 #include <string_view>
 #include <type_traits>
@@ -29,6 +30,11 @@
 namespace hilldem {
 
 inline constexpr std::uint32_t kCheckpointFormatVersion = 1;
+
+// Reads and writes of checkpoint files of at least this size report on the stream given to
+// set_state_io_log (start, every ~5 s, end with the time taken); none when it is null (the default).
+inline constexpr std::size_t kLargeStateBytes = std::size_t{100} << 20;
+void set_state_io_log(std::ostream* out);
 
 // CRC-32 (IEEE 802.3, as zlib), continuing from `crc` (0 to start).
 std::uint32_t crc32(const void* data, std::size_t size, std::uint32_t crc = 0);
@@ -127,10 +133,18 @@ class CheckpointWriter {
   SectionWriter& section(const std::string& name, std::uint32_t version = 1);
   // The whole file as bytes.
   std::string bytes() const;
-  // Atomic write to path (tmp file, fsync, rename, fsync of the folder). Throws RunError on I/O failure.
+  // Atomic write to path (tmp file, fsync, rename, fsync of the folder), streamed from the sections
+  // (the file is never assembled in memory). Throws RunError on I/O failure.
   void write_file(const std::string& path) const;
 
+  struct SectionView {
+    const std::string* name;
+    std::uint32_t version;
+    const std::string* payload;
+  };
+
  private:
+  std::vector<SectionView> views() const;
   struct Section {
     std::string name;
     std::uint32_t version;

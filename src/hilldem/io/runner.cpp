@@ -15,7 +15,9 @@
 
 #include "hilldem/core/error.hpp"
 #include "hilldem/io/fault_injection.hpp"
+#include "hilldem/io/output_folder.hpp"
 #include "hilldem/io/state_io.hpp"
+#include "hilldem/io/stop_signal.hpp"
 #include "hilldem/io/vtk_writer.hpp"
 
 namespace hilldem {
@@ -99,36 +101,44 @@ namespace {
 constexpr const char* kCheckpointFolder = "checkpoints";
 constexpr const char* kMetaSection = "run.meta";
 
+// Temporary files of atomic writes (NAME.tmp.PID, io/checkpoint.cpp) that a killed run left in
+// `folder`. Called only while holding the folder's lock, so no live writer owns them.
+void remove_torn_files(const std::string& folder) {
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(folder, ec)) {
+    const std::string name = e.path().filename().string();
+    const std::size_t at = name.rfind(".tmp.");
+    if (at == std::string::npos || at == 0 || at + 5 == name.size()) continue;
+    if (name.find_first_not_of("0123456789", at + 5) != std::string::npos) continue;
+    if (e.is_regular_file(ec)) fs::remove(e.path(), ec);
+  }
+}
+
 // ---- history CSV ----
 
 class HistoryWriter {
  public:
   // A new file with its header line.
   HistoryWriter(const Scenario& sc, const std::string& path) : sc_(sc), path_(path) { open_fresh(); }
-  // Continue a file a checkpoint recorded at `bytes` bytes: rows written after that checkpoint are
-  // cut off (the resumed run writes them again). A missing or shorter file starts afresh (reported).
-  HistoryWriter(const Scenario& sc, const std::string& path, std::uint64_t bytes, std::ostream& log) : sc_(sc), path_(path) {
+  // Continue a file whose first `bytes` bytes check_history_prefix verified (their CRC-32 is `crc`):
+  // rows written after that checkpoint are cut off (the resumed run writes them again).
+  HistoryWriter(const Scenario& sc, const std::string& path, std::uint64_t bytes, std::uint32_t crc)
+      : sc_(sc), path_(path), crc_(crc) {
     std::error_code ec;
-    const auto size = fs::file_size(path, ec);
-    if (ec || size < bytes) {
-      log << fmt::format("warning: {} is {} than the checkpoint recorded ({} bytes); it restarts here\n", path,
-                         ec ? "missing, not longer" : "shorter", bytes);
-      open_fresh();
-      return;
-    }
     fs::resize_file(path, bytes, ec);
     if (ec) throw InputError(path + ": cannot cut the history back to the checkpoint: " + ec.message());
     out_.open(path, std::ios::binary | std::ios::app);
     if (!out_) throw InputError(path + ": cannot append to the history file");
   }
   void sample(const Simulation& sim) {
-    out_ << sim.steps << "," << fmt::format("{:.9e}", sim.time);
+    std::string row = fmt::format("{},{:.9e}", sim.steps, sim.time);
     for (const History& h : sc_.histories) {
       const double v = evaluate(sc_, h.quantity, h.servo);
-      out_ << ",";
-      if (std::isfinite(v)) out_ << fmt::format("{:.9e}", v);
+      row += ",";
+      if (std::isfinite(v)) row += fmt::format("{:.9e}", v);
     }
-    out_ << "\n";
+    row += "\n";
+    put(row);
   }
   // Flush and return the file's length [bytes].
   std::uint64_t flush() {
@@ -136,20 +146,66 @@ class HistoryWriter {
     if (!out_) throw RunError(path_ + ": writing the history failed");
     return static_cast<std::uint64_t>(out_.tellp());
   }
+  // CRC-32 of every byte of the file, for the checkpoints (a resume checks the file against it).
+  std::uint32_t crc() const { return crc_; }
   const std::string& path() const { return path_; }
 
  private:
+  void put(const std::string& text) {
+    crc_ = crc32(text.data(), text.size(), crc_);
+    out_ << text;
+  }
   void open_fresh() {
     out_.open(path_, std::ios::binary | std::ios::trunc);
     if (!out_) throw InputError(path_ + ": cannot write the history file");
-    out_ << "step,time[s]";
-    for (const History& h : sc_.histories) out_ << "," << h.name << "[" << h.quantity.unit << "]";
-    out_ << "\n";
+    std::string head = "step,time[s]";
+    for (const History& h : sc_.histories) head += "," + h.name + "[" + h.quantity.unit + "]";
+    put(head + "\n");
   }
   const Scenario& sc_;
   std::string path_;
   std::ofstream out_;
+  std::uint32_t crc_ = 0;
 };
+
+// The history a checkpoint continues: the first `bytes` bytes of `path` must be what the run had
+// written when `checkpoint` was taken (that length and, when the checkpoint records it, that CRC-32),
+// or the resumed history would silently lose or mix rows. With `copy_to`, those bytes are copied
+// there (resume -o NEWDIR). Returns their CRC-32. InputError otherwise, naming both files.
+std::uint32_t check_history_prefix(const std::string& path, std::uint64_t bytes, std::optional<std::uint32_t> crc,
+                                   const std::string& checkpoint, const std::string& copy_to) {
+  const std::string advice = "; resuming would lose or mix its rows. Restore the file, or start the run again";
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec))
+    throw InputError(fmt::format("{}: the history file is missing; the checkpoint {} continues it from {} bytes{}", path,
+                                 checkpoint, bytes, advice));
+  const auto size = fs::file_size(path, ec);
+  if (ec || size < bytes)
+    throw InputError(fmt::format("{}: the history file has {} bytes, shorter than the {} bytes the checkpoint {} recorded{}",
+                                 path, ec ? 0 : size, bytes, checkpoint, advice));
+  std::ifstream in(path, std::ios::binary);
+  std::ofstream out;
+  if (!copy_to.empty()) {
+    out.open(copy_to, std::ios::binary | std::ios::trunc);
+    if (!out) throw InputError(copy_to + ": cannot write the history file");
+  }
+  std::vector<char> buf(std::size_t{1} << 20);
+  std::uint32_t sum = 0;
+  for (std::uint64_t left = bytes; left > 0;) {
+    const auto n = static_cast<std::streamsize>(std::min<std::uint64_t>(left, buf.size()));
+    if (!in.read(buf.data(), n)) throw InputError(path + ": cannot read the history file");
+    sum = crc32(buf.data(), static_cast<std::size_t>(n), sum);
+    if (out) out.write(buf.data(), n);
+    left -= static_cast<std::uint64_t>(n);
+  }
+  if (crc && *crc != sum)
+    throw InputError(fmt::format("{}: the history file's first {} bytes are not the rows the run had written when the "
+                                 "checkpoint {} was taken (CRC-32 {:08x}, recorded {:08x}): it was changed or written by "
+                                 "another run{}",
+                                 path, bytes, checkpoint, sum, *crc, advice));
+  if (out && !out.flush()) throw InputError(copy_to + ": writing the history file failed");
+  return sum;
+}
 
 void apply_set(Simulation& sim, const Stage& s) {
   for (std::size_t k : s.sel.walls) {
@@ -213,7 +269,8 @@ struct Position {
   std::vector<FixityMask> saved_fixity;  // translate/rotate: the fixity to restore at the end
 };
 
-struct Halted {};  // RunOptions::halt_after_step reached or stop_requested() said so
+struct Halted {};   // RunOptions::halt_after_step reached or stop_requested() said so
+struct Stopped {};  // a stop signal arrived (io/stop_signal.hpp)
 
 std::string stage_head(const Scenario& sc, std::size_t k) {
   const Stage& s = sc.stages[k];
@@ -283,7 +340,9 @@ class Runner {
   }
 
   // Continue from a checkpoint whose sim.* sections are already restored into the scenario.
-  RunResult resume(const CheckpointReader& r, const std::string& dir) {
+  // `source_dir`: the folder whose outputs the checkpoint continues ("": `dir` itself).
+  RunResult resume(const CheckpointReader& r, const std::string& dir, const std::string& source_dir) {
+    source_dir_ = source_dir;
     read_position(r);
     last_checkpoint_stage_ = pos_.stage;  // the checkpoint resumed from is at this position
     open_outputs(dir, &r);
@@ -346,15 +405,18 @@ class Runner {
       sim_.controllers.push_back([servo = &s.servo](Simulation& sim, double dt) { servo->control(sim, dt); });
     if (!opt_.write_files || dir.empty()) return;
     std::error_code ec;
-    fs::create_directories(dir, ec);
-    if (ec) throw InputError(dir + ": cannot create the output folder: " + ec.message());
+    // The folder is ours until the run ends (a second run or resume on it is refused), which also
+    // makes it safe to remove what killed runs left half written.
+    lock_ = OutputLock(dir, "output folder");
     dir_ = dir;
+    remove_torn_files(dir);
 
     std::uint64_t history_bytes = 0;
+    std::optional<std::uint32_t> history_crc;
     std::vector<SnapshotEntry> entries;
     bool had_history = false;
     if (resume) {
-      SectionReader s = resume->section("run.outputs");
+      SectionReader s = resume->section("run.outputs", 2);
       had_history = s.boolean();
       history_bytes = s.u64();
       const std::uint64_t n = s.count(24, 100'000'000);
@@ -367,12 +429,31 @@ class Runner {
         entries.push_back(e);
       }
       seq_ = s.u64();
+      if (s.version() >= 2) history_crc = s.u32();
       s.finish();
     }
+    // Resuming into another folder (-o NEWDIR): what the run had written up to the checkpoint is
+    // copied there, so that the folder is complete on its own.
+    std::error_code eq;
+    const bool elsewhere =
+        resume && !source_dir_.empty() && fs::is_directory(source_dir_, eq) && !fs::equivalent(source_dir_, dir, eq);
+    if (elsewhere) {
+      const std::string who = OutputLock::holder(source_dir_);
+      if (!who.empty())
+        throw InputError(source_dir_ + ": the run in this folder is still going (" + who +
+                         "); resume it when it has stopped");
+    }
+    const std::string from = elsewhere ? source_dir_ : dir;
     if (!sc_.histories.empty()) {
       result_.history_path = (fs::path(dir) / sc_.history_file).string();
-      history_ = resume && had_history ? std::make_unique<HistoryWriter>(sc_, result_.history_path, history_bytes, log_)
-                                       : std::make_unique<HistoryWriter>(sc_, result_.history_path);
+      if (resume && had_history) {
+        const std::string source = (fs::path(from) / sc_.history_file).string();
+        const std::uint32_t crc =
+            check_history_prefix(source, history_bytes, history_crc, resume->source(), elsewhere ? result_.history_path : "");
+        history_ = std::make_unique<HistoryWriter>(sc_, result_.history_path, history_bytes, crc);
+      } else {
+        history_ = std::make_unique<HistoryWriter>(sc_, result_.history_path);
+      }
       const std::int64_t every = sc_.history_every;
       sim_.observers.push_back([h = history_.get(), every](const Simulation& s) {
         if (s.steps % every == 0) h->sample(s);
@@ -382,7 +463,28 @@ class Runner {
       result_.snapshot_dir = (fs::path(dir) / sc_.snapshots.folder).string();
       snapshots_ = std::make_unique<SnapshotSeries>(
           result_.snapshot_dir, SnapshotOptions{sc_.snapshots.contacts, sc_.snapshots.walls, sc_.snapshots.binary});
-      if (resume) snapshots_->restore(std::move(entries));
+      remove_torn_files(result_.snapshot_dir);
+      if (resume) {
+        // Every snapshot the index lists must be there (or be copied there), or the .pvd would
+        // point at missing files.
+        const fs::path src = fs::path(from) / sc_.snapshots.folder;
+        std::vector<std::string> kinds{"balls"};
+        if (sc_.snapshots.contacts) kinds.push_back("contacts");
+        if (sc_.snapshots.walls) kinds.push_back("walls");
+        for (const SnapshotEntry& e : entries)
+          for (const std::string& kind : kinds) {
+            const std::string name = fmt::format("{}_{:06}.vtp", kind, e.index);
+            if (!fs::is_regular_file(src / name, ec))
+              throw InputError(fmt::format("{}: missing; the snapshot index of the checkpoint {} lists it (step {}). "
+                                           "Restore it, or start the run again",
+                                           (src / name).string(), resume->source(), e.step));
+            if (elsewhere) {
+              fs::copy_file(src / name, fs::path(result_.snapshot_dir) / name, fs::copy_options::overwrite_existing, ec);
+              if (ec) throw InputError(result_.snapshot_dir + ": cannot copy " + name + " into it: " + ec.message());
+            }
+          }
+        snapshots_->restore(std::move(entries));
+      }
     }
     if (sc_.checkpoints.enabled) {
       result_.checkpoint_dir = (fs::path(dir) / kCheckpointFolder).string();
@@ -394,7 +496,13 @@ class Runner {
         const std::string name = e.path().filename().string();
         if (std::sscanf(name.c_str(), "ckpt-%llu.hdc", &n) == 1 && name == fmt::format("ckpt-{:06}.hdc", n) && n > seq_)
           fs::remove(e.path(), ec);
-        if (name.find(".tmp.") != std::string::npos) fs::remove(e.path(), ec);  // torn writes of a killed run
+      }
+      remove_torn_files(result_.checkpoint_dir);
+      // A folder resumed into holds the checkpoint it starts from, so it can itself be resumed.
+      if (elsewhere && fs::is_regular_file(resume->source(), ec)) {
+        const fs::path copy = fs::path(result_.checkpoint_dir) / fmt::format("ckpt-{:06}.hdc", seq_);
+        fs::copy_file(resume->source(), copy, fs::copy_options::overwrite_existing, ec);
+        if (ec) throw InputError(copy.string() + ": cannot copy the checkpoint resumed from: " + ec.message());
       }
       last_checkpoint_time_ = now_seconds();
     }
@@ -432,7 +540,7 @@ class Runner {
       }
     }
     {
-      SectionWriter& s = w.section("run.outputs");
+      SectionWriter& s = w.section("run.outputs", 2);  // version 2: the history's CRC-32 at the end
       s.boolean(history_ != nullptr);
       s.u64(flush_history());
       const std::vector<SnapshotEntry> none;
@@ -444,10 +552,11 @@ class Runner {
         s.f64(e.time);
       }
       s.u64(seq_);
+      s.u32(history_ ? history_->crc() : 0);
     }
     {
       // The output settings this run uses (the scenario's, or the command line's over them).
-      SectionWriter& s = w.section("run.settings");
+      SectionWriter& s = w.section("run.settings", 2);  // version 2: stage_end_min_seconds at the end
       const SnapshotSettings& sn = sc_.snapshots;
       s.boolean(sn.enabled);
       s.i64(sn.every);
@@ -463,6 +572,7 @@ class Runner {
       s.boolean(c.at_stage_ends);
       s.i64(c.keep);
       s.f64(sc_.blowup_fraction);
+      s.f64(c.stage_end_min_seconds);
     }
     {
       SectionWriter& s = w.section("run.servos");
@@ -479,9 +589,16 @@ class Runner {
     if (result_.checkpoint_dir.empty()) return;
     ++seq_;
     const std::string path = (fs::path(result_.checkpoint_dir) / fmt::format("ckpt-{:06}.hdc", seq_)).string();
-    CheckpointWriter w;
-    write_run_sections(w, kind, "");
-    w.write_file(path);
+    try {
+      CheckpointWriter w;
+      write_run_sections(w, kind, "");
+      w.write_file(path);
+    } catch (const std::bad_alloc&) {
+      progress_.clear();
+      throw OutOfMemory(fmt::format("writing the checkpoint {} ({} balls, {} neighbour rows)", path, sim_.balls.size(),
+                                    sim_.contacts.size()),
+                        state_memory_estimate(sim_.balls.size(), sim_.contacts.size()));
+    }
     result_.last_checkpoint = path;
     last_checkpoint_stage_ = pos_.stage;
     last_checkpoint_time_ = now_seconds();
@@ -515,6 +632,11 @@ class Runner {
   void cycle_once() {
     try {
       sim_.cycle(1);
+    } catch (const std::bad_alloc&) {
+      progress_.clear();
+      throw OutOfMemory(fmt::format("cycling {} at step {} ({} balls, {} neighbour rows)", stage_head(sc_, pos_.stage),
+                                    sim_.steps, sim_.balls.size(), sim_.contacts.size()),
+                        state_memory_estimate(sim_.balls.size(), sim_.contacts.size()));
     } catch (const RunError& e) {
       progress_.clear();
       const std::string what = e.what();
@@ -572,6 +694,9 @@ class Runner {
     fault_injection().on_step(sim_.steps);
     if (opt_.halt_after_step >= 0 && sim_.steps >= opt_.halt_after_step) throw Halted{};
     if (opt_.stop_requested && opt_.stop_requested()) throw Halted{};
+    // (At a stage's last cycle the stop waits for the stage end: a solve resumed at its last step
+    // would cycle once more.)
+    if (!stage_ends && stop_requested()) throw Stopped{};
   }
 
   void run_motion(const Stage& s) {
@@ -671,6 +796,7 @@ class Runner {
       const std::size_t n = sc_.stages.size();
       if (pos_.stage >= n) result_.already_complete = true;
       while (pos_.stage < n) {
+        if (stop_requested()) throw Stopped{};
         const std::size_t k = pos_.stage;
         const Stage& s = sc_.stages[k];
         ProgressStage ps{k + 1, n, to_string(s.type), s.name, -1, 0.0, 0};
@@ -686,7 +812,9 @@ class Runner {
         pos_.stage = k + 1;
         if (changes_state(s.type)) {
           if (snapshots_ && sc_.snapshots.at_stage_ends) snapshots_->write(sim_, true);
-          if (sc_.checkpoints.at_stage_ends) checkpoint("stage end");
+          // (Many short stages would otherwise spend their time writing checkpoints.)
+          if (sc_.checkpoints.at_stage_ends && now_seconds() - last_checkpoint_time_ >= sc_.checkpoints.stage_end_min_seconds)
+            checkpoint("stage end");
         }
       }
       if (!result_.checkpoint_dir.empty() && last_checkpoint_stage_ != n) checkpoint("final");
@@ -694,6 +822,11 @@ class Runner {
     } catch (const Halted&) {
       progress_.clear();
       result_.halted = true;
+    } catch (const Stopped&) {
+      progress_.clear();
+      result_.stopped_by = stop_requested();
+      checkpoint(fmt::format("stopped by {}", signal_name(result_.stopped_by)).c_str());
+      flush_history();
     }
     return result_;
   }
@@ -706,6 +839,8 @@ class Runner {
   RunResult result_;
   Position pos_;
   std::string dir_;
+  std::string source_dir_;
+  OutputLock lock_;
   std::unique_ptr<HistoryWriter> history_;
   std::unique_ptr<SnapshotSeries> snapshots_;
   std::uint64_t seq_ = 0;
@@ -802,7 +937,7 @@ std::string find_checkpoint(const std::string& path, std::ostream& log) {
 namespace {
 
 RunResult resume_from(const CheckpointReader& r, Scenario& sc, const RunOptions& options, const std::string& dir,
-                      std::ostream& log) {
+                      const std::string& source_dir, std::ostream& log) {
   {
     SectionReader meta = r.section(kMetaSection);
     const std::string kind = meta.str(4096);
@@ -812,7 +947,7 @@ RunResult resume_from(const CheckpointReader& r, Scenario& sc, const RunOptions&
   }
   restore_scenario(r, sc);
   {
-    SectionReader s = r.section("run.settings");
+    SectionReader s = r.section("run.settings", 2);
     SnapshotSettings& sn = sc.snapshots;
     sn.enabled = s.boolean();
     sn.every = s.i64();
@@ -828,8 +963,9 @@ RunResult resume_from(const CheckpointReader& r, Scenario& sc, const RunOptions&
     c.at_stage_ends = s.boolean();
     const std::int64_t keep = s.i64();
     sc.blowup_fraction = s.f64();
+    c.stage_end_min_seconds = s.version() >= 2 ? s.f64() : 0.0;  // version 1 wrote every stage end
     s.finish();
-    if (sn.every < 0 || c.every < 0 || !(c.every_seconds >= 0.0) || keep < 1 || keep > 1000 || !(sc.blowup_fraction >= 0.0) ||
+    if (sn.every < 0 || c.every < 0 || !(c.every_seconds >= 0.0) || !(c.stage_end_min_seconds >= 0.0 && c.stage_end_min_seconds <= 1e9) || keep < 1 || keep > 1000 || !(sc.blowup_fraction >= 0.0) ||
         sn.folder.empty() || sn.folder.find('/') != std::string::npos || sn.folder == "." || sn.folder == "..")
       s.fail("output settings out of range");
     c.keep = static_cast<int>(keep);
@@ -843,7 +979,7 @@ RunResult resume_from(const CheckpointReader& r, Scenario& sc, const RunOptions&
                        steps);
   }
   Runner runner(sc, options, log);
-  RunResult result = runner.resume(r, dir);
+  RunResult result = runner.resume(r, dir, source_dir);
   result.resumed_from = r.source();
   return result;
 }
@@ -851,18 +987,28 @@ RunResult resume_from(const CheckpointReader& r, Scenario& sc, const RunOptions&
 }  // namespace
 
 RunResult resume_scenario(const CheckpointReader& r, Scenario& sc, const RunOptions& options, std::ostream& log) {
-  return resume_from(r, sc, options, options.output_dir, log);
+  return resume_from(r, sc, options, options.output_dir, "", log);
 }
 
 RunResult resume_scenario(const std::string& path, Scenario& sc, const RunOptions& options, std::ostream& log) {
+  {
+    // A folder whose run is still going is refused before anything else is looked at.
+    std::error_code ec;
+    fs::path folder = fs::absolute(fs::path(path), ec).lexically_normal();
+    if (!folder.has_filename()) folder = folder.parent_path();  // "run/checkpoints/"
+    if (!fs::is_directory(folder, ec)) folder = folder.parent_path();
+    if (folder.filename() == kCheckpointFolder) folder = folder.parent_path();
+    const std::string who = OutputLock::holder(folder.string());
+    if (!who.empty())
+      throw InputError(folder.string() + ": the output folder is in use by another hilldem process (" + who +
+                       "); resume it when that process has ended");
+  }
   const std::string file = find_checkpoint(path, log);
   const CheckpointReader r = CheckpointReader::from_file(file);
-  std::string dir = options.output_dir;
-  if (dir.empty()) {
-    const fs::path parent = fs::absolute(fs::path(file)).parent_path();
-    dir = (parent.filename() == kCheckpointFolder ? parent.parent_path() : parent).string();
-  }
-  return resume_from(r, sc, options, dir, log);
+  const fs::path parent = fs::absolute(fs::path(file)).parent_path();
+  const std::string source = (parent.filename() == kCheckpointFolder ? parent.parent_path() : parent).string();
+  const std::string dir = options.output_dir.empty() ? source : options.output_dir;
+  return resume_from(r, sc, options, dir, source, log);
 }
 
 std::string describe_checkpoint(const std::string& path, std::optional<std::int64_t> ball) {

@@ -55,6 +55,7 @@ struct RunResult {
   std::string checkpoint_dir;   // "" when no checkpoints were written
   std::string last_checkpoint;  // the newest checkpoint file written ("" when none)
   bool halted = false;          // RunOptions::halt_after_step was reached
+  int stopped_by = 0;           // the signal that stopped the run between cycles (io/stop_signal.hpp); 0: none
   bool already_complete = false;  // resume_scenario found a finished run
   std::string resumed_from;       // resume_scenario: the checkpoint it continued from
   const ProbeValue* find(const std::string& label) const;
@@ -75,7 +76,8 @@ struct OutputOverrides {
 };
 OutputOverrides& output_overrides();
 
-// Runs every stage in order. Stage lines and listings go to `log`. Throws RunError when a stage
+// Runs every stage in order. After SIGINT, SIGTERM or SIGHUP (when io/stop_signal's handlers are
+// installed) it finishes the cycle, writes a checkpoint and returns with RunResult::stopped_by set. Stage lines and listings go to `log`. Throws RunError when a stage
 // fails, InputError when an output cannot be created.
 RunResult run_scenario(Scenario& sc, const RunOptions& options, std::ostream& log);
 

@@ -9,7 +9,9 @@
 #include <sstream>
 
 #include "hilldem/core/error.hpp"
+#include "hilldem/io/output_folder.hpp"
 #include "hilldem/io/packing_import.hpp"
+#include "hilldem/io/state_io.hpp"
 
 #include <filesystem>
 
@@ -40,6 +42,16 @@ constexpr double kMaxBalls = 5e7;  // a guard against typos that would exhaust m
 const Range kPoisson = Range::open_closed(-1.0, 0.5);    // spec §2.2
 const Range kDampCon = Range::closed_open(0.0, 1.0);      // spec §2.2
 const Range kLocalDamping = Range::closed_open(0.0, 1.0);
+// Magnitudes beyond which a run is meaningless in double precision or physically absurd
+// (docs/scenario-format.md, "Ranges"): a coordinate of 1e6 m keeps ~1e-10 m resolution; radii from
+// a nanometre to a kilometre; densities from 1e-3 (lighter than any gas at 1 atm would be) to
+// 1e6 kg/m^3 (50 x osmium); gravity up to 1e4 m/s^2 (1000 g, a centrifuge) per component.
+constexpr double kMaxCoordinate = 1e6;  // [m]
+const Range kCoordinate = Range::closed(-kMaxCoordinate, kMaxCoordinate);
+const Range kBallRadius = Range::closed(1e-9, 1e3);  // [m]
+const Range kDensity = Range::closed(1e-3, 1e6);     // [kg/m^3]
+const Range kGravity = Range::closed(-1e4, 1e4);     // [m/s^2] each component
+bool within(const Range& r, const Vec3& v) { return r.contains(v.x) && r.contains(v.y) && r.contains(v.z); }
 
 struct Material {
   double density, young_mod, pois_ratio;
@@ -115,7 +127,7 @@ class Reader {
     SimulationSettings& s = sc.sim.settings;
     auto t = root_.table("simulation");
     if (!t) return;
-    s.gravity = t->vec3("gravity", Vec3{}, Range::any(), "[m/s^2]");
+    s.gravity = t->vec3("gravity", Vec3{}, kGravity, "[m/s^2]");
     s.local_damping = t->real("local_damping", 0.0, kLocalDamping, "[-]");
     if (t->has("timestep") && t->is_string("timestep")) {
       t->choice("timestep", std::nullopt, {"auto"});
@@ -137,8 +149,8 @@ class Reader {
       s.box.periodic[d[0] - 'x'] = true;
     }
     if (t->has("box_min") || t->has("box_max")) {
-      s.box.lo = t->vec3("box_min", std::nullopt, Range::any(), "[m]");
-      s.box.hi = t->vec3("box_max", std::nullopt, Range::any(), "[m]");
+      s.box.lo = t->vec3("box_min", std::nullopt, kCoordinate, "[m]");
+      s.box.hi = t->vec3("box_max", std::nullopt, kCoordinate, "[m]");
       for (int d = 0; d < 3; ++d)
         if (s.box.periodic[d] && !(s.box.lo[d] < s.box.hi[d])) t->fail("box_max", "must exceed box_min in every periodic direction");
       box_given_ = true;
@@ -152,8 +164,10 @@ class Reader {
     sc.output_dir = t->string("dir", "");
     sc.history_every = t->integer("history_every", 1, 1, INT64_MAX);
     sc.history_file = t->string("history_file", "history.csv");
-    if (sc.history_file.empty() || sc.history_file.find('/') != std::string::npos)
-      t->fail("history_file", "must be a plain file name (no '/')");
+    if (sc.history_file.empty() || sc.history_file.find('/') != std::string::npos || sc.history_file == "." ||
+        sc.history_file == ".." || sc.history_file == kLockFileName)
+      t->fail("history_file", "must be a plain file name (not empty, \".\", \"..\" or \"" + std::string(kLockFileName) +
+                                  "\"; no '/'); got \"" + sc.history_file + "\"");
     t->finish();
   }
 
@@ -181,6 +195,8 @@ class Reader {
     c.every = t->integer("every", 0, 0, INT64_MAX);
     c.every_seconds = t->real("every_seconds", 600.0, Range::closed(0.0, 1e9), "[s] (0: not by time)");
     c.at_stage_ends = t->boolean("at_stage_ends", true);
+    c.stage_end_min_seconds =
+        t->real("stage_end_min_seconds", 60.0, Range::closed(0.0, 1e9), "[s] (no stage-end checkpoint this soon after the last one)");
     c.keep = static_cast<int>(t->integer("keep", 2, 1, 1000));
     t->finish();
   }
@@ -275,7 +291,7 @@ class Reader {
     const std::string name = t.string("name", std::nullopt);
     if (materials_.count(name)) t.fail("name", "material \"" + name + "\" is defined twice");
     Material m;
-    m.density = t.real("density", std::nullopt, Range::positive(), "[kg/m^3]");
+    m.density = t.real("density", std::nullopt, kDensity, "[kg/m^3]");
     m.young_mod = t.real("young_mod", 0.0, Range::closed(0.0, kInf), "[Pa]");
     m.pois_ratio = t.real("pois_ratio", 0.0, kPoisson, "[-]");
     t.finish();
@@ -298,7 +314,7 @@ class Reader {
     b.density = m.density;
     b.young_mod = m.young_mod;
     b.pois_ratio = m.pois_ratio;
-    b.radius = t.real("radius", std::nullopt, Range::positive(), "[m]");
+    b.radius = t.real("radius", std::nullopt, kBallRadius, "[m]");
     b.groups = read_groups(t, sim.groups);
     b.fixity = read_fixity(t, "fix");
     b.velocity = t.vec3("velocity", Vec3{}, Range::any(), "[m/s]");
@@ -316,7 +332,7 @@ class Reader {
   void read_ball(TableReader& t, SimulationDescription& sim) {
     BallInit b = common_ball(t, sim);
     b.id = t.integer("id", std::nullopt, 0, INT64_MAX);
-    b.position = t.vec3("position", std::nullopt, Range::any(), "[m]");
+    b.position = t.vec3("position", std::nullopt, kCoordinate, "[m]");
     t.finish();
     add_ball(t, sim, b);
   }
@@ -324,7 +340,7 @@ class Reader {
   void read_ball_grid(TableReader& t, SimulationDescription& sim) {
     BallInit b = common_ball(t, sim);
     std::int64_t id = t.integer("first_id", std::nullopt, 0, INT64_MAX);
-    const Vec3 origin = t.vec3("origin", std::nullopt, Range::any(), "[m]");
+    const Vec3 origin = t.vec3("origin", std::nullopt, kCoordinate, "[m]");
     const Vec3 counts = t.vec3("counts", std::nullopt, Range::closed(1, 1000), "[-]");
     if (counts.x != std::floor(counts.x) || counts.y != std::floor(counts.y) || counts.z != std::floor(counts.z))
       t.fail("counts", "must be whole numbers [nx, ny, nz]");
@@ -333,11 +349,21 @@ class Reader {
     if (static_cast<double>(id) + counts.x * counts.y * counts.z > 9.2e18)
       t.fail("first_id", "ids would overflow a 64-bit integer");
     const double spacing = t.real("spacing", std::nullopt, Range::positive(), "[m]");
+    const Vec3 last = origin + (counts - Vec3{1, 1, 1}) * spacing;
+    if (!within(kCoordinate, last))
+      t.fail("spacing", fmt::format("the grid's far corner [{:g}, {:g}, {:g}] m is outside {} [m] (origin + (counts - 1) x spacing)",
+                                    last.x, last.y, last.z, kCoordinate.text()));
     t.finish();
     const double total = counts.x * counts.y * counts.z;
     if (total + static_cast<double>(sim.balls.size()) > static_cast<double>(limits_.max_balls))
       t.fail("counts", fmt::format("{:g} balls: more than {} balls in the scenario (the limit for one scenario)", total,
                                    limits_.max_balls));
+    try {
+      sim.balls.reserve(sim.balls.size() + static_cast<std::size_t>(total));
+    } catch (const std::bad_alloc&) {
+      throw OutOfMemory(fmt::format("reading {} ({:g} balls of a [[ball_grid]])", t.where("counts"), total),
+                        (total + static_cast<double>(sim.balls.size())) * static_cast<double>(sizeof(BallInit)));
+    }
     for (int k = 0; k < static_cast<int>(counts.z); ++k)
       for (int j = 0; j < static_cast<int>(counts.y); ++j)
         for (int i = 0; i < static_cast<int>(counts.x); ++i) {
@@ -384,6 +410,11 @@ class Reader {
       box_given_ = true;
     }
     for (const ImportedBall& ib : p.balls) {
+      if (!within(kCoordinate, ib.position) || !kBallRadius.contains(ib.radius) || !(ib.density <= 0.0 || kDensity.contains(ib.density)))
+        t.fail("file", fmt::format("\"{}\": a ball at [{:g}, {:g}, {:g}] m with radius {:g} m and density {:g} kg/m^3; positions "
+                                   "must be in {} [m], radii in {} [m], densities in {} [kg/m^3]",
+                                   path, ib.position.x, ib.position.y, ib.position.z, ib.radius, ib.density,
+                                   kCoordinate.text(), kBallRadius.text(), kDensity.text()));
       BallInit b;
       b.id = id++;
       b.position = ib.position;
@@ -419,6 +450,22 @@ class Reader {
     for (std::size_t i = 0; i < sim.balls.size(); ++i)
       if (!std::isfinite(norm(sim.balls[i].position)))
         throw InputError(file_ + ": ball " + std::to_string(sim.balls[i].id) + " has a non-finite position");
+    // The cell grid needs at least 3 cells across a period, each at least one interaction length
+    // wide (contact/cell_grid.cpp): refuse here, naming the key, what the first rebuild would refuse.
+    if (sim.balls.empty()) return;
+    double rmax = 0.0, rsum = 0.0;
+    for (const BallInit& b : sim.balls) rmax = std::max(rmax, b.radius), rsum += b.radius;
+    const SimulationSettings& s = sim.settings;
+    const double skin = s.skin > 0.0 ? s.skin : 0.1 * 2.0 * rsum / static_cast<double>(sim.balls.size());
+    const double interaction = 2.0 * rmax + s.proximity + skin;
+    for (int d = 0; d < 3; ++d) {
+      const double length = s.box.hi[d] - s.box.lo[d];
+      if (s.box.periodic[d] && !(length >= 3.0 * interaction))
+        throw InputError(fmt::format(
+            "{}: key 'simulation.box_max': the periodic box is {:g} m long in {}; it must be at least 3 interaction "
+            "lengths, 3 x (2 R_max + proximity + skin) = 3 x ({:g} + {:g} + {:g}) = {:g} m",
+            file_, length, static_cast<char>('x' + d), 2.0 * rmax, s.proximity, skin, 3.0 * interaction));
+    }
   }
 
   void motion_keys(TableReader& t, Wall& w) {
@@ -435,28 +482,31 @@ class Reader {
     const std::string type = t.choice("type", std::nullopt, {"plane", "facet", "cylinder", "box"});
     if (type == "plane") {
       w.shape = WallShape::Plane;
-      w.point = t.vec3("point", std::nullopt, Range::any(), "[m]");
+      w.point = t.vec3("point", std::nullopt, kCoordinate, "[m]");
       const Vec3 n = t.vec3("normal", std::nullopt, Range::any(), "[-]");
       if (norm(n) == 0.0) t.fail("normal", "must not be the zero vector");
       w.normal = n / norm(n);
-      w.rotation_center = t.vec3("rotation_center", w.point, Range::any(), "[m]");
+      w.rotation_center = t.vec3("rotation_center", w.point, kCoordinate, "[m]");
       motion_keys(t, w);
     } else if (type == "facet") {
       w.shape = WallShape::Facet;
       const auto v = t.vec3_list("vertices", "[m]");
       if (v.size() != 3) t.fail("vertices", "a facet needs exactly 3 vertices");
+      for (const Vec3& x : v)
+        if (!within(kCoordinate, x))
+          t.fail("vertices", fmt::format("every coordinate must be in {} [m]; got [{:g}, {:g}, {:g}]", kCoordinate.text(), x.x, x.y, x.z));
       if (norm(cross(v[1] - v[0], v[2] - v[0])) == 0.0) t.fail("vertices", "the 3 vertices are collinear");
       for (int k = 0; k < 3; ++k) w.vertex[k] = v[k];
-      w.rotation_center = t.vec3("rotation_center", (v[0] + v[1] + v[2]) / 3.0, Range::any(), "[m]");
+      w.rotation_center = t.vec3("rotation_center", (v[0] + v[1] + v[2]) / 3.0, kCoordinate, "[m]");
       motion_keys(t, w);
     } else if (type == "cylinder") {
       w.shape = WallShape::Cylinder;
       const std::string axis = t.choice("axis", "z", {"x", "y", "z"});
       w.axis = axis[0] - 'x';
-      w.point = t.vec3("center", std::nullopt, Range::any(), "[m]");
+      w.point = t.vec3("center", std::nullopt, kCoordinate, "[m]");
       w.radius = t.real("radius", std::nullopt, Range::positive(), "[m]");
       if (t.has("extent")) {
-        const auto e = t.reals("extent", Range::any(), "[m]");
+        const auto e = t.reals("extent", kCoordinate, "[m]");
         if (e.size() != 2 || !(e[0] < e[1]))
           t.fail("extent", "must be [lo, hi] with lo < hi [m], along the axis from the center");
         w.lo = e[0];
@@ -476,8 +526,8 @@ class Reader {
   // A box of 12 facets (2 per face) named <name>.<face>.<1|2>, each in the groups <name> and
   // <name>.<face> (faces xmin, xmax, ymin, ymax, zmin, zmax), so `wall = "box.zmin"` sums the floor.
   void read_box(TableReader& t, SimulationDescription& sim, const Wall& base) {
-    const Vec3 lo = t.vec3("min", std::nullopt, Range::any(), "[m]");
-    const Vec3 hi = t.vec3("max", std::nullopt, Range::any(), "[m]");
+    const Vec3 lo = t.vec3("min", std::nullopt, kCoordinate, "[m]");
+    const Vec3 hi = t.vec3("max", std::nullopt, kCoordinate, "[m]");
     if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z)) t.fail("max", "must exceed min in x, y and z");
     t.finish();
     const char* faces[6] = {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
@@ -622,7 +672,7 @@ class Reader {
         if (t.has("radial_velocity"))
           s.radial_velocity = t.real("radial_velocity", std::nullopt, Range::any(), "[m/s]");
       } else {
-        if (t.has("position")) s.position = t.vec3("position", std::nullopt, Range::any(), "[m]");
+        if (t.has("position")) s.position = t.vec3("position", std::nullopt, kCoordinate, "[m]");
         if (t.has("applied_force")) s.applied_force = t.vec3("applied_force", std::nullopt, Range::any(), "[N]");
         s.fix = read_fixity(t, "fix");
         s.free = read_fixity(t, "free");
@@ -645,7 +695,7 @@ class Reader {
       }
     } else if (type == "set_simulation") {
       s.type = StageType::SetSimulation;
-      if (t.has("gravity")) s.gravity = t.vec3("gravity", std::nullopt, Range::any(), "[m/s^2]");
+      if (t.has("gravity")) s.gravity = t.vec3("gravity", std::nullopt, kGravity, "[m/s^2]");
       if (t.has("local_damping")) s.local_damping = t.real("local_damping", std::nullopt, kLocalDamping, "[-]");
       if (t.has("timestep")) {
         if (t.is_string("timestep")) {
@@ -723,12 +773,21 @@ ScenarioDescription read_scenario_file(const std::string& path) {
   if (!in) throw InputError(path + ": cannot open the scenario file");
   std::ostringstream ss;
   ss << in.rdbuf();
-  return read_scenario(ss.str(), path);
+  try {
+    return read_scenario(ss.str(), path);
+  } catch (const std::bad_alloc&) {
+    throw OutOfMemory("reading the scenario " + path, -1.0);
+  }
 }
 
 Scenario build_scenario(ScenarioDescription d) {
   Scenario sc;
-  sc.sim = build_simulation(d.sim);
+  try {
+    sc.sim = build_simulation(d.sim);
+  } catch (const std::bad_alloc&) {
+    throw OutOfMemory(fmt::format("building the simulation of {} ({} balls)", d.file, d.sim.balls.size()),
+                      state_memory_estimate(d.sim.balls.size(), 0));
+  }
   static_cast<ScenarioPlan&>(sc) = std::move(d);
   return sc;
 }

@@ -87,6 +87,7 @@ struct CheckpointSettings {
   std::int64_t every = 0;       // every N steps (0: not by steps)
   double every_seconds = 600;   // every S seconds of wall-clock time (0: not by time)
   bool at_stage_ends = true;    // after every stage that cycles or changes the state
+  double stage_end_min_seconds = 60;  // [s] no stage-end checkpoint within this long of the last one
   int keep = 2;                 // newest checkpoints kept (older ones are deleted)
 };
 

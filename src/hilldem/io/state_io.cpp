@@ -310,6 +310,16 @@ void check_contacts(SectionReader& r, const ContactStore& c, std::size_t n_balls
 }  // namespace
 
 void write_simulation(CheckpointWriter& w, const Simulation& sim) {
+  // Without a periodic box the neighbour rows that are not contacts are not saved: a rebuild at the
+  // restored run's first cycle finds them again, and results do not depend on when the list is
+  // rebuilt. In a periodic box a rebuild wraps positions (x - L rounds differently from x), so
+  // there every row and the rebuild schedule are saved.
+  // (Columns of unequal lengths, a store no engine makes, are written as they are, for the reader
+  // to refuse.)
+  bool even = true;
+  ContactStore::zip_columns(sim.contacts, sim.contacts,
+                            [&](const auto& col, const auto&) { even = even && col.size() == sim.contacts.key.size(); });
+  const bool compact = !sim.settings.box.any() && even;
   {
     SectionWriter& s = w.section("sim.clock");
     s.f64(sim.time);
@@ -347,17 +357,25 @@ void write_simulation(CheckpointWriter& w, const Simulation& sim) {
     std::uint32_t columns = 0;
     ContactStore::zip_columns(sim.contacts, sim.contacts, [&](const auto&, const auto&) { ++columns; });
     s.u32(columns);
-    ContactStore::zip_columns(sim.contacts, sim.contacts, [&](const auto& col, const auto&) { put_column(s, col); });
+    if (compact) {
+      ContactStore rows;  // the contacts only
+      for (std::size_t c = 0; c < sim.contacts.size(); ++c)
+        if (sim.contacts.exists[c]) rows.append_row(sim.contacts, c);
+      ContactStore::zip_columns(rows, rows, [&](const auto& col, const auto&) { put_column(s, col); });
+    } else {
+      ContactStore::zip_columns(sim.contacts, sim.contacts, [&](const auto& col, const auto&) { put_column(s, col); });
+    }
   }
   {
-    // The cycle's bookkeeping: the restored run rebuilds its neighbour list when this one would have.
+    // The cycle's bookkeeping: the restored run rebuilds its neighbour list when this one would have
+    // (compact: at its first cycle, the neighbour rows not being saved).
     SectionWriter& s = w.section("sim.cycle");
     const CycleState cs = sim.cycle_state();
     s.boolean(cs.forces_ready);
-    s.boolean(cs.rebuild_needed);
+    s.boolean(compact || cs.rebuild_needed);
     s.i64(cs.rebuilds);
     s.u64(cs.unassigned_pairs);
-    put_column(s, cs.position_at_build);
+    put_column(s, compact ? std::vector<Vec3>{} : cs.position_at_build);
     s.f64(cs.wall_travel);
   }
   {
@@ -633,10 +651,17 @@ std::string state_bytes(const Simulation& sim) {
 }
 
 std::string state_digest(const Simulation& sim) {
+  // FNV-1a over state_bytes, part by part (the same bytes in the same order, without concatenating them).
   std::uint64_t h = 1469598103934665603ull;
-  for (unsigned char ch : state_bytes(sim)) {
-    h ^= ch;
-    h *= 1099511628211ull;
+  auto mix = [&h](const std::string& bytes) {
+    for (unsigned char ch : bytes) {
+      h ^= ch;
+      h *= 1099511628211ull;
+    }
+  };
+  for (const Part& p : state_parts(sim)) {
+    mix(p.label);
+    mix(p.bytes);
   }
   return fmt::format("{:016x}", h);
 }
@@ -655,6 +680,15 @@ std::string state_difference(const Simulation& a, const Simulation& b) {
     }
   }
   return "";
+}
+
+double state_memory_estimate(std::size_t balls, std::size_t rows) {
+  std::size_t per_ball = 0, per_row = 0;
+  BallStore b;
+  b.for_each_column([&](auto& c) { per_ball += sizeof(typename std::decay_t<decltype(c)>::value_type); });
+  ContactStore c;
+  ContactStore::zip_columns(c, c, [&](auto& col, auto&) { per_row += sizeof(typename std::decay_t<decltype(col)>::value_type); });
+  return 2.0 * (static_cast<double>(balls) * static_cast<double>(per_ball) + static_cast<double>(rows) * static_cast<double>(per_row));
 }
 
 }  // namespace hilldem

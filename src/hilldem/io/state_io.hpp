@@ -49,6 +49,9 @@ void read_servo(SectionReader& r, Servo& servo);  // validates the ranges (Input
 std::string state_bytes(const Simulation& sim);
 // 64-bit FNV-1a of state_bytes, as 16 hex digits.
 std::string state_digest(const Simulation& sim);
+// Rough memory of a state [bytes]: its ball and contact columns, doubled for the engine's own
+// per-ball records and row lists and for the growth of vectors. For out-of-memory messages.
+double state_memory_estimate(std::size_t balls, std::size_t rows);
 // Where two states first differ, in words ("" when they are bitwise equal).
 std::string state_difference(const Simulation& a, const Simulation& b);
 
