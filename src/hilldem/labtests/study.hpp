@@ -77,6 +77,16 @@ struct StudyResult {
   std::vector<std::string> findings() const;  // the memo's qualitative claims, each with numbers and a verdict
 };
 
+// Physically impossible states and results, each with its reason (empty: none found). A state is
+// impossible when a wall stress lies more than kStateTolerance × target from the target it was brought
+// to (the servos stop within ε_P = 1 %); results are impossible when a loop reverses at q_A ≤ 0 or
+// dissipates negative energy (loop area or damping ratio below 0), a fitted M_r is not positive, or
+// the peak deviator under compression is not positive. run_study and make_packed throw RunError
+// (exit status 1) with these reasons instead of writing a summary.
+inline constexpr double kStateTolerance = 0.25;  // [-]
+std::vector<std::string> impossible_state(const SpecimenState& st, double target);
+std::vector<std::string> impossible_results(const TriaxialResult& r);
+
 // Runs the cases (settings.jobs at once), writing into settings.output_dir as each one ends; progress
 // to log (may be null). If a case fails, no new case starts and the error of the first failing case
 // (in case order) is thrown once the running ones end.
