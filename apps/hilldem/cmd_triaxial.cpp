@@ -147,6 +147,7 @@ int run(const Options& o) {
     const std::clock_t c0 = std::clock();
     const std::vector<PackedResult> packed = make_all_packed(settings, cases, true, log);
     std::cout << "\n" << packing_table(packed);
+    std::cout << "\nconverged when " << criterion_text(settings.genesis.packing.equilibrium) << "\n";
     std::cout << fmt::format("\nspecimens: {}/specimens/; {:.0f} s wall, {:.0f} s CPU\n", settings.output_dir,
                              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
                              static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC);

@@ -120,6 +120,13 @@ std::string interior_cell(const SpecimenState& s) {
   return s.interior_margin == SpecimenState::Margin::None ? std::string() : fmt::format("{:.6g}", s.interior_porosity);
 }
 
+// The packing's convergence: its porosity change per 1,000 steps at the end, or why there is none.
+std::string packing_change_text(const std::vector<PhaseReport>& phases) {
+  for (const PhaseReport& ph : phases)
+    if (ph.name == "packing" && ph.porosity_change >= 0) return fmt::format("{:.1e}", ph.porosity_change);
+  return "n/a (loaded)";
+}
+
 std::size_t max_loops(const std::vector<CaseResult>& cases) {
   std::size_t n = 0;
   for (const CaseResult& c : cases) n = std::max(n, c.test.loops.size());
@@ -133,7 +140,7 @@ std::string StudyResult::summary_csv() const {
   std::string out =
       "case,grading,material,wet,packing_model,grains,porosity_packed[-],interior_porosity_packed[-],interior_margin_packed[m],"
       "porosity_test_start[-],interior_porosity_test_start[-],coordination_packed[-],coordination_test_start[-],"
-      "sigma_r_start[Pa],sigma_axial_start[Pa],peak_q[Pa],peak_eps_a[-]";
+      "sigma_r_start[Pa],sigma_axial_start[Pa],peak_q[Pa],peak_eps_a[-],peak_eps_r[-],peak_eps_v[-],packing_porosity_change_per_1000_steps[-]";
   for (std::size_t k = 1; k <= nl; ++k)
     out += fmt::format(",eps_A_cycle{0}[-],Mr_fit_cycle{0}[Pa],Mr_fit_se_cycle{0}[Pa],Mr_unload_secant_cycle{0}[Pa],"
                        "reload_fit_cycle{0}[Pa],reload_fit_se_cycle{0}[Pa],reload_secant_cycle{0}[Pa],loop_area_cycle{0}[J/m3],"
@@ -146,6 +153,8 @@ std::string StudyResult::summary_csv() const {
                        c.packed.porosity, interior_cell(c.packed), c.packed.interior_margin_length, c.initial.porosity,
                        interior_cell(c.initial), c.packed.coordination, c.initial.coordination, c.initial.radial_stress,
                        0.5 * (c.initial.bottom_stress + c.initial.top_stress), c.test.peak_q, c.test.peak_strain);
+    const std::string dn = packing_change_text(c.phases);
+    out += fmt::format(",{:.6g},{:.6g},{}", c.test.peak_radial_strain, c.test.peak_volumetric_strain, dn.rfind("n/a", 0) == 0 ? "" : dn);
     for (std::size_t k = 0; k < nl; ++k) {
       if (k < c.test.loops.size()) {
         const LoopResult& l = c.test.loops[k];
@@ -166,9 +175,9 @@ std::string StudyResult::summary_csv() const {
 std::string StudyResult::summary_markdown() const {
   const std::size_t nl = max_loops(cases);
   std::string head =
-      "| case | packed with | grains | porosity packed: vessel / interior | at test start: vessel / interior | Z packed | Z | "
-      "peak q [kPa] | at eps_a [%] |";
-  std::string rule = "|---|---|---:|---:|---:|---:|---:|---:|---:|";
+      "| case | packed with | grains | porosity packed: vessel / interior | packing dn per 1000 steps | at test start: vessel / interior | "
+      "Z packed | Z | peak q [kPa] | at eps_a [%] | eps_v at peak [%] |";
+  std::string rule = "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|";
   for (std::size_t k = 1; k <= nl; ++k) {
     head += fmt::format(" M_r c{0} [MPa] | secant c{0} [MPa] | reload c{0} [MPa] | loop c{0} [J/m³] |", k);
     rule += "---:|---:|---:|---:|";
@@ -177,10 +186,10 @@ std::string StudyResult::summary_markdown() const {
   rule += "---:|---:|---:|---:|";
   std::string out = head + "\n" + rule + "\n";
   for (const CaseResult& c : cases) {
-    out += fmt::format("| {} | {} | {} | {:.4f} / {} | {:.4f} / {} | {:.2f} | {:.2f} | {:.1f} | {:.3f} |", c.spec.name(),
-                       to_string(c.packed_with), c.initial.grains, c.packed.porosity, interior_text(c.packed), c.initial.porosity,
-                       interior_text(c.initial), c.packed.coordination, c.initial.coordination, c.test.peak_q / 1e3,
-                       100 * c.test.peak_strain);
+    out += fmt::format("| {} | {} | {} | {:.4f} / {} | {} | {:.4f} / {} | {:.2f} | {:.2f} | {:.1f} | {:.3f} | {:.3f} |", c.spec.name(),
+                       to_string(c.packed_with), c.initial.grains, c.packed.porosity, interior_text(c.packed),
+                       packing_change_text(c.phases), c.initial.porosity, interior_text(c.initial), c.packed.coordination,
+                       c.initial.coordination, c.test.peak_q / 1e3, 100 * c.test.peak_strain, 100 * c.test.peak_volumetric_strain);
     for (std::size_t k = 0; k < nl; ++k) {
       if (k < c.test.loops.size()) {
         const LoopResult& l = c.test.loops[k];
@@ -201,7 +210,11 @@ std::string StudyResult::summary_markdown() const {
          "and restores its friction (mu = 0.4). Each material is packed with its own model unless --pack-linear.\n"
          "Porosity: vessel = 1 − V_grains/(π R² H); interior = in the coaxial cylinder one D_max in from every wall (D50 where\n"
          "the vessel is too small for that: marked; n/a where even that leaves less than D_max in radius or 2 D_max in height).\n"
-         "Time: finalization, wetting and test of the case (wall clock); packing is done once per grading and packing model.\n";
+         "Time: finalization, wetting and test of the case (wall clock); packing is done once per grading and packing model.\n"
+         "eps_v = eps_a + 2 eps_r (compression positive; negative: dilation), at the peak deviator.\n";
+  if (!criterion.empty())
+    out += "Packing, finalization and wetting converged when " + criterion +
+           "; packing dn: the packing's vessel-porosity change per 1,000 steps at its end.\n";
   const auto f = findings();
   if (!f.empty()) {
     out += "\nFindings of the memo, checked (a comparison of M_r holds or fails only where the difference exceeds twice its\n"
@@ -422,15 +435,15 @@ PackedResult make_packed(const StudySettings& settings, const std::string& gradi
 
 std::string packing_table(const std::vector<PackedResult>& packed) {
   std::string out = "| grading | packed with | seed | grains | porosity (vessel) | porosity (interior) | Z | sigma_r [kPa] | "
-                    "sigma_bottom [kPa] | sigma_top [kPa] | packing steps | time [s] |\n"
-                    "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+                    "sigma_bottom [kPa] | sigma_top [kPa] | packing steps | dn per 1000 steps | time [s] |\n"
+                    "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const PackedResult& p : packed) {
     std::int64_t steps = 0;
     for (const PhaseReport& ph : p.specimen.phases) steps += ph.steps;
-    out += fmt::format("| {} | {} | {} | {} | {:.4f} | {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {} | {:.0f} |\n", p.report.name,
+    out += fmt::format("| {} | {} | {} | {} | {:.4f} | {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {} | {} | {:.0f} |\n", p.report.name,
                        to_string(p.specimen.packed_with), p.specimen.seed, p.state.grains, p.state.porosity, interior_text(p.state),
-                       p.state.coordination,
-                       p.state.radial_stress / 1e3, p.state.bottom_stress / 1e3, p.state.top_stress / 1e3, steps, p.seconds);
+                       p.state.coordination, p.state.radial_stress / 1e3, p.state.bottom_stress / 1e3, p.state.top_stress / 1e3, steps,
+                       packing_change_text(p.specimen.phases), p.seconds);
   }
   return out;
 }
@@ -631,6 +644,7 @@ StudyResult run_study(const StudySettings& settings, const std::vector<CaseSpec>
   std::vector<std::optional<CaseResult>> done(cases.size());
   std::mutex done_mutex;
   StudyResult study;
+  study.criterion = criterion_text(settings.genesis.packing.equilibrium);
   std::vector<std::string> names;
   for (const CaseSpec& c : cases) names.push_back(c.name());
   const int jobs = resolved_jobs(settings.jobs, cases.size());
@@ -692,6 +706,7 @@ StudyResult run_study(const StudySettings& settings, const std::vector<CaseSpec>
     const std::lock_guard<std::mutex> lock(done_mutex);
     done[i] = std::move(r);
     StudyResult so_far;
+    so_far.criterion = study.criterion;
     for (const auto& d : done)
       if (d) so_far.cases.push_back(*d);
     write_file(out / "summary.csv", so_far.summary_csv());

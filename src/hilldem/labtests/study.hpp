@@ -70,6 +70,7 @@ struct CaseResult {
 
 struct StudyResult {
   std::vector<CaseResult> cases;
+  std::string criterion;                // the servo equilibria's convergence criterion in words (criterion_text)
   double seconds = 0.0;                 // wall clock [s]
   double cpu_seconds = 0.0;             // process CPU time, all threads [s]
   std::string summary_csv() const;

@@ -231,7 +231,8 @@ TriaxialResult run_triaxial(Specimen& s, const TriaxialSettings& t, std::ostream
     const double conf_err = std::abs(r.sigma_r - t.confinement) / t.confinement;
     if (conf_err > res.worst_confinement_error) res.worst_confinement_error = conf_err, res.worst_confinement_strain = r.eps_a;
     if (r.platen_mismatch > res.worst_platen_mismatch) res.worst_platen_mismatch = r.platen_mismatch, res.worst_mismatch_strain = r.eps_a;
-    if (r.q > res.peak_q) res.peak_q = r.q, res.peak_strain = r.eps_a;
+    if (r.q > res.peak_q)
+      res.peak_q = r.q, res.peak_strain = r.eps_a, res.peak_radial_strain = r.eps_r, res.peak_volumetric_strain = r.eps_v;
     tracker.add(phase, cycle, r.eps_a, r.q);
     const double rec = phase == TriaxialPhase::Final ? final_rec : cycle_rec;
     if (force_record || std::abs(r.eps_a - last_rec_eps) >= rec) record(r);
@@ -279,9 +280,11 @@ TriaxialResult run_triaxial(Specimen& s, const TriaxialSettings& t, std::ostream
   res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (log) {
     *log << res.loops_text();
-    *log << fmt::format("triaxial: {} steps, {:.1f} s; peak q {:.2f} kPa at eps_a {:.3f} %; worst confinement error {:.3f} % "
+    *log << fmt::format("triaxial: {} steps, {:.1f} s; peak q {:.2f} kPa at eps_a {:.3f} % (eps_r {:.3f} %, eps_v {:.3f} %); "
+                        "worst confinement error {:.3f} % "
                         "(at {:.4f} %); worst platen mismatch {:.2f} % (at {:.4f} %)\n",
-                        res.steps, res.seconds, res.peak_q / 1e3, 100 * res.peak_strain, 100 * res.worst_confinement_error,
+                        res.steps, res.seconds, res.peak_q / 1e3, 100 * res.peak_strain, 100 * res.peak_radial_strain,
+                        100 * res.peak_volumetric_strain, 100 * res.worst_confinement_error,
                         100 * res.worst_confinement_strain, 100 * res.worst_platen_mismatch, 100 * res.worst_mismatch_strain);
   }
   return res;

@@ -102,6 +102,7 @@ struct TriaxialResult {
   std::vector<LoopResult> loops;
   double height0 = 0.0, radius0 = 0.0;            // [m] at the start
   double peak_q = 0.0, peak_strain = 0.0;         // [Pa], [-]
+  double peak_radial_strain = 0.0, peak_volumetric_strain = 0.0;  // ε_r, ε_v at the peak [-] (compression positive)
   double worst_confinement_error = 0.0;           // max |σ_r − σ_c| / σ_c over every cycle [-]
   double worst_confinement_strain = 0.0;          // ε_a where it happened
   double worst_platen_mismatch = 0.0;             // max |σ_top − σ_bottom| / σ_a over every cycle [-]
