@@ -464,6 +464,57 @@ TEST(SpecimenFile, PhysicallyBrokenSpecimensAreRefusedWithTheLineAndRange) {
 }
 
 // States and results that cannot be physical are named (run_study then fails with exit status 1).
+// A sweep runs every case at each confinement, named by it; the findings compare cases of one confinement.
+TEST(Study, ConfinementSweepNamesTheCasesAndGroupsTheFindings) {
+  const auto cases = sweep_confinements(memo_cases(), {50e3, 100e3});
+  ASSERT_EQ(cases.size(), 10u);
+  EXPECT_EQ(cases[0].name(), "C5n_Linear_50kPa");
+  EXPECT_EQ(cases[9].name(), "C5b_Hill_wet_100kPa");
+  EXPECT_EQ(memo_cases()[3].name(), "C5b_Hill");  // no sweep: no suffix
+  StudySettings st;
+  EXPECT_DOUBLE_EQ(confinement_of(st, cases[9]), 100e3);
+  EXPECT_DOUBLE_EQ(confinement_of(st, memo_cases()[0]), st.triaxial.confinement);
+  StudyResult r;
+  for (const CaseSpec& c : cases) {
+    CaseResult cr;
+    cr.spec = c;
+    cr.grading.name = c.grading;
+    LoopResult l;
+    l.closed = true;
+    l.loop_area = c.model == GrainModel::Hill ? 2.0 : 1.0;
+    l.unload.valid = true;
+    l.unload.slope = (c.grading == "C5b" ? 200e6 : 100e6) * c.confinement / 100e3;
+    l.unload.slope_se = 1e6;
+    cr.test.loops = {l};
+    cr.test.peak_q = c.confinement;
+    r.cases.push_back(cr);
+  }
+  const auto f = r.findings();
+  ASSERT_EQ(f.size(), 10u);  // five claims at each of two confinements
+  EXPECT_EQ(f[0].rfind("at sigma_c = 50 kPa: hysteresis loops larger", 0), 0u) << f[0];
+  EXPECT_EQ(f[5].rfind("at sigma_c = 100 kPa: hysteresis loops larger", 0), 0u) << f[5];
+  // Within one confinement C5b is stiffer (across them a 50 kPa C5b would not be).
+  EXPECT_NE(f[1].find("HOLDS (2 of 2 comparisons)"), std::string::npos) << f[1];
+  EXPECT_NE(f[6].find("M_r C5b 200.0 +- 1.0 vs C5n 100.0 +- 1.0 MPa"), std::string::npos) << f[6];
+}
+
+// The default vessel: a grading holding fewer than min_grains gets the same shape scaled up.
+TEST(Study, MinGrainsScalesUpTheVesselOfACoarseGrading) {
+  StudySettings st;
+  st.genesis.vessel_radius = 0.0425;
+  st.genesis.vessel_height = 0.120;
+  const Grading n = grading_c5n(), b = grading_c5b();
+  const double n_half = expected_grains(n, 1.0, 0.0425, 0.120, 0.58);
+  EXPECT_GT(n_half, 90);  // about 110 grains of 14-20 mm in the half-size vessel
+  EXPECT_LT(n_half, 130);
+  EXPECT_EQ(vessel_for(st, n), std::make_pair(0.0425, 0.120));  // min_grains 0: as given
+  st.min_grains = 500;
+  const auto [rn, hn] = vessel_for(st, n);
+  EXPECT_NEAR(rn / 0.0425, hn / 0.120, 1e-12);  // the same shape
+  EXPECT_NEAR(expected_grains(n, 1.0, rn, hn, 0.58), 500, 1e-6);
+  EXPECT_EQ(vessel_for(st, b), std::make_pair(0.0425, 0.120));  // C5b holds ~1,700: never scaled down
+}
+
 TEST(Study, ImpossibleStatesAndResultsAreNamed) {
   SpecimenState st;
   st.porosity = 0.35;

@@ -133,3 +133,27 @@ foreach(case "one_centre|2|have one centre" "grown|2|of the smaller diameter; at
             -o ${HILLDEM_TRIAXIAL_OUT}/broken/out_${mode})
   set_tests_properties(cli.triaxial_broken_specimen_${mode}_exits_${status} PROPERTIES TIMEOUT 120 LABELS "cli;labtests")
 endforeach()
+# Options: a sweep of confinements, the T 307 vessel, the minimum grain count; bad values exit 2.
+add_test(NAME cli.triaxial_confinement_sweep_runs_each_case_at_each
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stdout "| fine_Hill_100kPa |" --stdout "| fine_Hill_150kPa |" --stdout "triaxial: confinement 100 kPa"
+          --not-stdout "nan"
+          0 $<TARGET_FILE:hilldem> triaxial --specimen ${HILLDEM_TEST_DATA}/labtests/mini_packed.csv
+            --grading ${HILLDEM_TEST_DATA}/labtests/fine.csv --confinement 100e3,150e3 --cycles 0.02
+            --final-strain 0.04 --strain-rate 0.1 --final-strain-rate 0.5 --threads 1 --jobs 1 --no-plot -o ${HILLDEM_TRIAXIAL_OUT}/sweep)
+add_test(NAME cli.triaxial_repeated_confinement_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "--confinement lists 100000 Pa twice" --not-stdout "cloud"
+          2 $<TARGET_FILE:hilldem> triaxial --confinement 100e3,100e3 -o ${HILLDEM_TRIAXIAL_OUT}/bad17)
+add_test(NAME cli.triaxial_negative_confinement_in_a_sweep_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "--confinement must be a finite number > 0 Pa, got -5" --not-stdout "cloud"
+          2 $<TARGET_FILE:hilldem> triaxial --confinement=100e3,-5 -o ${HILLDEM_TRIAXIAL_OUT}/bad18)
+add_test(NAME cli.triaxial_unknown_vessel_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "unknown vessel 'cube': choose memo (170 mm x 240 mm) or t307" --not-stdout "cloud"
+          2 $<TARGET_FILE:hilldem> triaxial --vessel cube -o ${HILLDEM_TRIAXIAL_OUT}/bad19)
+# The T 307 shape (H/D = 2) scaled by 0.15: 23 mm x 46 mm.
+add_test(NAME cli.triaxial_t307_vessel_has_h_over_d_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stdout "in a 23 mm x 46 mm vessel" --not-stdout "nan"
+          0 $<TARGET_FILE:hilldem> triaxial --pack-only --vessel t307 --grading ${HILLDEM_TEST_DATA}/labtests/fine.csv --scale 0.15
+            --seed 42 --threads 1 -o ${HILLDEM_TRIAXIAL_OUT}/t307)
+set_tests_properties(cli.triaxial_confinement_sweep_runs_each_case_at_each cli.triaxial_repeated_confinement_exits_2
+  cli.triaxial_negative_confinement_in_a_sweep_exits_2 cli.triaxial_unknown_vessel_exits_2 cli.triaxial_t307_vessel_has_h_over_d_2
+  PROPERTIES TIMEOUT 120 LABELS "cli;labtests")

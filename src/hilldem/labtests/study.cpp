@@ -13,6 +13,7 @@
 #include <fstream>
 #include <map>
 #include <mutex>
+#include <numbers>
 #include <ostream>
 #include <streambuf>
 #include <thread>
@@ -39,7 +40,41 @@ std::string CaseSpec::name() const {
   if (low == "c5n") g = "C5n";
   else if (low == "c5b") g = "C5b";
   else g = fs::path(grading).stem().string();
-  return g + (model == GrainModel::Hill ? "_Hill" : "_Linear") + (wet ? "_wet" : "");
+  return g + (model == GrainModel::Hill ? "_Hill" : "_Linear") + (wet ? "_wet" : "") +
+         (confinement > 0 ? fmt::format("_{:g}kPa", confinement / 1e3) : std::string());
+}
+
+std::vector<CaseSpec> sweep_confinements(const std::vector<CaseSpec>& cases, const std::vector<double>& confinements) {
+  std::vector<CaseSpec> out;
+  for (double sc : confinements)
+    for (CaseSpec c : cases) {
+      c.confinement = sc;
+      out.push_back(c);
+    }
+  return out;
+}
+
+double confinement_of(const StudySettings& settings, const CaseSpec& c) {
+  return c.confinement > 0 ? c.confinement : settings.triaxial.confinement;
+}
+
+double expected_grains(const Grading& g, double d_mult, double R, double H, double n_c) {
+  double per_volume = 0.0;  // grains per unit solid volume
+  for (const GradingBin& b : g.bins) {
+    const double lo = b.d_lower * d_mult, hi = b.d_upper * d_mult;
+    // E[π d³/6] for d uniform in [lo, hi]: π (hi⁴ − lo⁴) / (24 (hi − lo)); π lo³/6 for a single size.
+    const double mean_v = hi > lo ? std::numbers::pi * (std::pow(hi, 4) - std::pow(lo, 4)) / (24.0 * (hi - lo))
+                                  : std::numbers::pi * lo * lo * lo / 6.0;
+    if (mean_v > 0) per_volume += b.fraction / mean_v;
+  }
+  return (1.0 - n_c) * std::numbers::pi * R * R * H * per_volume;
+}
+
+std::pair<double, double> vessel_for(const StudySettings& settings, const Grading& g) {
+  const GenesisSpec& v = settings.genesis;
+  const double n = expected_grains(g, v.d_mult, v.vessel_radius, v.vessel_height, v.packing.cloud_porosity);
+  const double f = settings.min_grains > 0 && n > 0 && n < settings.min_grains ? std::cbrt(settings.min_grains / n) : 1.0;
+  return {f * v.vessel_radius, f * v.vessel_height};
 }
 
 std::vector<CaseSpec> memo_cases() {
@@ -53,9 +88,14 @@ std::vector<CaseSpec> memo_cases() {
 void validate(const StudySettings& s, const std::vector<CaseSpec>& cases) {
   if (cases.empty()) throw InputError("no cases to run");
   validate(s.triaxial);
+  if (s.min_grains < 0 || s.min_grains > 1'000'000)
+    throw InputError(fmt::format("--min-grains must be in [0, 1000000], got {}", s.min_grains));
   for (const CaseSpec& c : cases) {
+    if (!(c.confinement >= 0) || !std::isfinite(c.confinement))
+      throw InputError(fmt::format("confinement must be a finite number > 0 Pa, got {:g}", c.confinement));
     GenesisSpec g = s.genesis;
     g.grading = resolve_grading(c.grading);
+    std::tie(g.vessel_radius, g.vessel_height) = vessel_for(s, g.grading);
     validate(g);
     if (c.wet && c.model != GrainModel::Hill)
       throw InputError("--wet needs the hill material: the linear model has no liquid bridges");
@@ -138,7 +178,7 @@ std::size_t max_loops(const std::vector<CaseResult>& cases) {
 std::string StudyResult::summary_csv() const {
   const std::size_t nl = max_loops(cases);
   std::string out =
-      "case,grading,material,wet,packing_model,grains,porosity_packed[-],interior_porosity_packed[-],interior_margin_packed[m],"
+      "case,grading,material,wet,packing_model,confinement[Pa],grains,porosity_packed[-],interior_porosity_packed[-],interior_margin_packed[m],"
       "porosity_test_start[-],interior_porosity_test_start[-],coordination_packed[-],coordination_test_start[-],"
       "sigma_r_start[Pa],sigma_axial_start[Pa],peak_q[Pa],peak_eps_a[-],peak_eps_r[-],peak_eps_v[-],packing_porosity_change_per_1000_steps[-]";
   for (std::size_t k = 1; k <= nl; ++k)
@@ -148,8 +188,8 @@ std::string StudyResult::summary_csv() const {
                        k);
   out += ",worst_confinement_error[-],worst_platen_mismatch[-],test_steps,packing_seconds,seconds\n";
   for (const CaseResult& c : cases) {
-    out += fmt::format("{},{},{},{},{},{},{:.6g},{},{:.6g},{:.6g},{},{:.6g},{:.6g},{:.9g},{:.9g},{:.9g},{:.6g}", c.spec.name(),
-                       c.grading.name, to_string(c.spec.model), c.spec.wet ? 1 : 0, to_string(c.packed_with), c.initial.grains,
+    out += fmt::format("{},{},{},{},{},{:g},{},{:.6g},{},{:.6g},{:.6g},{},{:.6g},{:.6g},{:.9g},{:.9g},{:.9g},{:.6g}", c.spec.name(),
+                       c.grading.name, to_string(c.spec.model), c.spec.wet ? 1 : 0, to_string(c.packed_with), c.confinement, c.initial.grains,
                        c.packed.porosity, interior_cell(c.packed), c.packed.interior_margin_length, c.initial.porosity,
                        interior_cell(c.initial), c.packed.coordination, c.initial.coordination, c.initial.radial_stress,
                        0.5 * (c.initial.bottom_stress + c.initial.top_stress), c.test.peak_q, c.test.peak_strain);
@@ -224,7 +264,9 @@ std::string StudyResult::summary_markdown() const {
   return out;
 }
 
-std::vector<std::string> StudyResult::findings() const {
+namespace {
+// The memo's findings over cases of one confinement.
+std::vector<std::string> findings_of(const std::vector<CaseResult>& cases) {
   std::vector<std::string> out;
   auto find = [&](const std::string& grading, GrainModel m, bool wet) -> const CaseResult* {
     for (const CaseResult& c : cases)
@@ -340,6 +382,22 @@ std::vector<std::string> StudyResult::findings() const {
   }
   return out;
 }
+}  // namespace
+
+std::vector<std::string> StudyResult::findings() const {
+  std::vector<double> levels;  // the confinements, in case order
+  for (const CaseResult& c : cases)
+    if (std::find(levels.begin(), levels.end(), c.spec.confinement) == levels.end()) levels.push_back(c.spec.confinement);
+  std::vector<std::string> out;
+  for (double sc : levels) {
+    std::vector<CaseResult> group;
+    for (const CaseResult& c : cases)
+      if (c.spec.confinement == sc) group.push_back(c);
+    for (const std::string& f : findings_of(group))
+      out.push_back(levels.size() > 1 ? fmt::format("at sigma_c = {:g} kPa: {}", sc / 1e3, f) : f);
+  }
+  return out;
+}
 
 std::vector<std::string> impossible_state(const SpecimenState& st, double target) {
   std::vector<std::string> out;
@@ -405,6 +463,7 @@ PackedResult make_packed(const StudySettings& settings, const std::string& gradi
   } else {
     GenesisSpec g = settings.genesis;
     g.grading = grading;
+    std::tie(g.vessel_radius, g.vessel_height) = vessel_for(settings, grading);
     g.grain = settings.material;
     g.packing = ps;
     p.specimen = pack_specimen(g, log);
@@ -422,9 +481,9 @@ PackedResult make_packed(const StudySettings& settings, const std::string& gradi
   if (log) *log << p.report.text() << state_text("packed", p.state);
   if (save && settings.specimen_file.empty()) {
     write_file(dir / (stem + "_gsd.csv"), p.report.csv());
+    const auto [vr, vh] = vessel_for(settings, grading);
     std::string gen = fmt::format("grading {}, seed {}, vessel {:g} mm x {:g} mm, P_m {:g} kPa, packed with {} contacts, friction {:g}\n",
-                                  grading.name, p.specimen.seed, 2e3 * settings.genesis.vessel_radius,
-                                  1e3 * settings.genesis.vessel_height, settings.genesis.packing.equilibrium.pressure / 1e3,
+                                  grading.name, p.specimen.seed, 2e3 * vr, 1e3 * vh, settings.genesis.packing.equilibrium.pressure / 1e3,
                                   to_string(model), ps.contact.fric);
     for (const PhaseReport& ph : p.specimen.phases) gen += ph.line() + "\n";
     gen += state_text("packed", p.state) + p.report.text();
@@ -677,16 +736,18 @@ StudyResult run_study(const StudySettings& settings, const std::vector<CaseSpec>
     EquilibriumSettings e = settings.finalize;
     finalize(s, m, settings.test_walls, e, clog);
     if (c.wet) make_specimen_wet(s, settings.suction, settings.moisture_gap, e, clog);
-    if (settings.triaxial.confinement != e.pressure) {  // isotropic at σ_c before the test
+    TriaxialSettings ts = settings.triaxial;
+    ts.confinement = r.confinement = confinement_of(settings, c);
+    if (ts.confinement != e.pressure) {  // isotropic at σ_c before the test
       EquilibriumSettings ce = e;
-      ce.pressure = settings.triaxial.confinement;
+      ce.pressure = ts.confinement;
       servo_equilibrium(s, ce, "confine " + s.material, clog);
     }
     r.initial = measure(s);
     r.phases = s.phases;
-    if (const auto bad = impossible_state(r.initial, settings.triaxial.confinement); !bad.empty())
+    if (const auto bad = impossible_state(r.initial, ts.confinement); !bad.empty())
       throw RunError(fmt::format("case {}: the state at the test start is physically impossible: {}", c.name(), joined(bad)));
-    r.test = run_triaxial(s, settings.triaxial, clog);
+    r.test = run_triaxial(s, ts, clog);
     if (const auto bad = impossible_results(r.test); !bad.empty())
       throw RunError(fmt::format("case {}: physically impossible results (no summary written): {}", c.name(), joined(bad)));
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - tc).count();
