@@ -243,7 +243,7 @@ std::string StudyResult::summary_markdown() const {
   }
   out += "\nM_r: resilient modulus, the slope of the least-squares line through the unload branch's points with q in the middle\n"
          "80 % of q_B..q_A, +- its standard error (inflated for the residuals' serial correlation); secant: the two-point unload\n"
-         "secant (q_A − q_B)/(eps_A − eps_B); reload: the same fit over the reload branch (q_B..q_C); "
+         "secant (q_A − q_B)/(eps_A − eps_B); reload: the same fit over the reload branch (q_B..q_C);\n"
          "loop: hysteresis, loop area ∮ q d(eps_a) = energy dissipated per unit volume. Z: touching grain-grain contacts per grain\n"
          "(Z packed: after packing; Z: at the test start).\n"
          "Packed with: the grain-grain contact model of the frictionless packing (mu = 0); finalization installs the material\n"
