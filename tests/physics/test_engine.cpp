@@ -161,6 +161,45 @@ TEST(TimeStep, AutomaticEstimateMatchesTheFormula) {
   EXPECT_NEAR(sim.estimate_timestep(), 0.8 * crit, 1e-9 * crit);
 }
 
+// Spec §4 after make_wet: the first cycle's Δt queries the new wet contact (Eq. 19 at
+// δ_o = 2e-4 R_o, since the grains are apart), not the dry state of the cycle before.
+TEST(TimeStep, FirstCycleAfterMakeWetUsesTheWetContact) {
+  Simulation sim = granite_row({1e-3});  // two free granite grains, R = 5 mm, 1 mm apart
+  sim.settings.auto_timestep = true;
+  sim.update_forces();                   // no contact: nothing bounds Δt yet
+  ASSERT_EQ(sim.make_wet(20e3, 3e-3), 1u);
+  const HillMapping& m = sim.contacts.hill_map[0];
+  const double root = std::sqrt(2e-4 * m.r_o);
+  const double kn = 1.5 * m.kn * root, ks = m.ks * root;  // no dashpot: F(ξ) = 1
+  const double arm2 = std::pow(5e-3 + 0.5e-3, 2);          // contact point in the middle of the gap
+  const double crit = std::min(std::sqrt(sim.balls.mass[0] / (kn + ks)), std::sqrt(sim.balls.inertia[0] / (ks * arm2)));
+  sim.cycle(1);
+  EXPECT_LT(sim.last_dt, sim.settings.timestep_max);
+  EXPECT_NEAR(sim.last_dt, 0.8 * crit, 1e-9 * crit);
+}
+
+// Spec §4 after new contact properties (set_contacts): raising γ_h from 0 to 0.07 on an existing
+// contact shortens the next Δt by F(ξ) (Eq. 20) at once, as if the contact had been made with it.
+TEST(TimeStep, NewPropertiesChangeTheNextTimeStep) {
+  auto pair = [](double damp) {
+    Simulation sim;
+    sim.balls.add(granite(1, {0, 0, 0}, 7.5e-3));
+    sim.balls.add(granite(2, {0, 0, 12.4e-3}, 5e-3));
+    sim.table.rules.push_back(hill_rule(0.4, damp));
+    sim.update_forces();
+    return sim;
+  };
+  Simulation changed = pair(0.0);
+  const double before = changed.estimate_timestep();
+  changed.contacts.hill_params[0].damp_con = 0.07;
+  changed.refresh_mappings();
+  const Simulation made = pair(0.07);
+  const double f = std::sqrt(1.0 + 0.035 * 0.035) - 0.035;
+  EXPECT_NEAR(changed.estimate_timestep(), f * before, 1e-12 * before);
+  // (to the rounding of the gap, which the force pass takes by another sequence of operations)
+  EXPECT_NEAR(changed.estimate_timestep(), made.estimate_timestep(), 1e-12 * before);
+}
+
 // Appendix A (spec §2.10) through the engine: after shearing, doubling the overlap with no further
 // shear motion leaves the shear force unchanged (incremental update).
 TEST(AppendixA, DoublingOverlapKeepsShearForce) {

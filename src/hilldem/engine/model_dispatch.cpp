@@ -67,6 +67,23 @@ void run_row_law(const ContactStore& contacts, std::size_t c, const RowLawInput&
   out.k_shear = stiff.ks;
 }
 
+TimestepStiffness timestep_stiffness(const ContactStore& contacts, std::size_t c, double gap) {
+  switch (contacts.model[c]) {
+    case ModelKind::Hill: {
+      if (!hill_active(contacts.moisture[c], gap)) return {};
+      const StiffnessEstimate k = hill_timestep_stiffness(contacts.hill_params[c], contacts.hill_map[c], gap);
+      return {true, k.kn + k.ks, k.ks};
+    }
+    case ModelKind::Linear:
+    case ModelKind::RrLinear: {
+      if (!(gap < 0.0)) return {};
+      const LinearMapping& m = contacts.linear_map[c];
+      return {true, m.kn + m.ks, m.ks};
+    }
+  }
+  return {};
+}
+
 double wall_normal_stiffness(const ContactStore& contacts, std::size_t c) {
   switch (contacts.model[c]) {
     case ModelKind::Hill: return contacts.k_tran[c];

@@ -49,6 +49,16 @@ constexpr BatchKind batch_of(ModelKind model) {
   return BatchKind::None;
 }
 
+// What the time-step estimate queries of row c before its law has run on its present state (after
+// make_wet, make_dry or new properties; spec §4: every active contact): whether the model counts it as
+// active at gap g [m] in its present state, and k̂_n + k̂_s and k̂_s [N/m] (hill: Eqs. 19-21).
+struct TimestepStiffness {
+  bool active = false;
+  double k_tran = 0.0;
+  double k_shear = 0.0;
+};
+TimestepStiffness timestep_stiffness(const ContactStore& contacts, std::size_t c, double gap);
+
 // What an active wall row adds to its wall's normal stiffness [N/m] (the servos' gain).
 double wall_normal_stiffness(const ContactStore& contacts, std::size_t c);
 

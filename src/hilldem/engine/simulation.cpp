@@ -157,6 +157,23 @@ ContactGeometry Simulation::geometry(std::size_t c) const {
 void Simulation::refresh_mappings() {
   body_terms_ready_ = false;
   for (std::size_t c = 0; c < contacts.size(); ++c) compute_mapping(balls, contacts, c);
+  refresh_timestep_stiffness();
+}
+
+void Simulation::refresh_timestep_stiffness() {
+  // The contacts' forces stay those of the last cycle (spec §2.7: F^m changes on the next cycle),
+  // but the time step of that cycle queries every contact active now with its present properties
+  // (spec §4), so each existing row's activity, gap and stiffness columns are its model's answer now.
+  for (std::size_t c = 0; c < contacts.size(); ++c) {
+    if (!contacts.exists[c]) continue;
+    const ContactGeometry g = geometry(c);
+    const TimestepStiffness k = g.valid ? timestep_stiffness(contacts, c, g.gap) : TimestepStiffness{};
+    contacts.active[c] = k.active;
+    if (g.valid) contacts.gap[c] = g.gap;
+    contacts.k_tran[c] = k.k_tran;
+    contacts.k_shear[c] = k.k_shear;
+  }
+  stiffness_.ready = false;  // the sums from the rows (StiffnessSums::of_ball)
 }
 
 void Simulation::advance_records(double dt, const double* inertial_mass, const double* inertial_inertia,
@@ -334,31 +351,37 @@ double Simulation::estimate_timestep() const {
 }
 
 double Simulation::mean_unbalanced_ratio() const {
-  double unbalanced = 0.0;
+  // PFC's mechanical ratio-average (spec lab-tests §3.4): the mean over free bodies of the
+  // unbalanced-force magnitude over the mean over the same bodies of the applied-force magnitude,
+  // that is the sum over a body's active contacts of |F_c| plus its weight m |g|. A contact's force
+  // counts as |F^s_n n̂ + F_s| + |F^m|, the magnitudes of its parts: a wet contact in equilibrium
+  // carries a Hertz force and an equal and opposite moisture force, and its net force is zero.
+  const std::size_t n = balls.size();
+  std::vector<double> applied(n, 0.0);
+  for (std::size_t c = 0; c < contacts.size(); ++c) {
+    if (!contacts.active[c]) continue;
+    const double fn = contacts.normal_force[c];
+    const double f = std::sqrt(fn * fn + norm2(contacts.shear_force(c))) + std::abs(contacts.moisture_force[c]);
+    const ContactKey& k = contacts.key[c];
+    applied[k.a] += f;
+    if (k.kind == ContactKind::BallBall) applied[k.b] += f;
+  }
+  const double g = norm(settings.gravity);
+  double unbalanced = 0.0, applied_sum = 0.0;
   std::size_t free_balls = 0;
-  for (std::size_t i = 0; i < balls.size(); ++i) {
+  for (std::size_t i = 0; i < n; ++i) {
     const FixityMask fix = balls.fixity[i];
     if ((fix & kFixVel) == kFixVel) continue;
     Vec3 f = unbalanced_force(balls, i, settings.gravity);
     for (int d = 0; d < 3; ++d)
       if (fix & (1u << d)) f[d] = 0.0;
     unbalanced += norm(f);
+    applied_sum += applied[i] + balls.mass[i] * g;
     ++free_balls;
   }
   if (free_balls == 0) return 0.0;
-  double contact = 0.0;
-  std::size_t active = 0;
-  for (std::size_t c = 0; c < contacts.size(); ++c)
-    if (contacts.active[c]) {
-      // Magnitudes of the parts, not of their sum: a wet contact in equilibrium carries a Hertz force
-      // and an equal and opposite moisture force, and its net force is zero.
-      const double fn = contacts.normal_force[c];
-      contact += std::sqrt(fn * fn + norm2(contacts.shear_force(c))) + std::abs(contacts.moisture_force[c]);
-      ++active;
-    }
-  unbalanced /= static_cast<double>(free_balls);
-  if (active == 0 || contact == 0.0) return unbalanced > 0.0 ? 1.0 : 0.0;
-  return unbalanced / (contact / static_cast<double>(active));
+  if (applied_sum == 0.0) return unbalanced > 0.0 ? 1.0 : 0.0;
+  return unbalanced / applied_sum;  // the two means share the divisor free_balls
 }
 
 std::size_t Simulation::make_wet(double suction, double gap) {
@@ -375,6 +398,7 @@ std::size_t Simulation::make_wet(double suction, double gap) {
     }
     if (contacts.exists[c] && contacts.moisture[c] == Moisture::Wet) ++wet;
   }
+  refresh_timestep_stiffness();
   return wet;
 }
 
@@ -385,6 +409,7 @@ std::size_t Simulation::make_dry() {
     if (contacts.moisture[c] == Moisture::Wet) ++was_wet;
     contacts.moisture[c] = Moisture::Dry;
   }
+  refresh_timestep_stiffness();
   return was_wet;
 }
 

@@ -69,8 +69,8 @@ class Simulation {
   double next_timestep() const;
   // f·Δt_crit from the contact stiffnesses (spec §4, hill Eqs. 19-21), or 0 if no contact reports one.
   double estimate_timestep() const;
-  // Mean unbalanced force over free balls / mean contact force over active contacts [-]; a contact's
-  // force counts as |F^s_n n̂ + F_s| + |F^m|.
+  // PFC's mechanical ratio-average [-]: mean unbalanced-force magnitude over free balls / mean
+  // applied-force magnitude over the same balls (their contacts' |F_c| and their weight).
   double mean_unbalanced_ratio() const;
 
   // Material-level wetting (spec §2.7): contacts for every ball pair within gap [m] (new ones
@@ -99,7 +99,7 @@ class Simulation {
 
   // Recompute every contact's mapping, and the per-ball terms and parameter sets the batched hill
   // law reads, after properties of bodies or contacts changed (radius, density, E, ν, a contact's
-  // μ, γ_h, ψ: the cycle does not watch them).
+  // μ, γ_h, ψ: the cycle does not watch them), and the stiffnesses the next Δt is estimated from.
   void refresh_mappings();
   // Rebuild the neighbour list before the next force evaluation (after bodies were added or moved
   // by hand, or the table changed).
@@ -140,6 +140,9 @@ class Simulation {
   void rebuild(double reach);
   void build_row_lists();  // the neighbour list's row lists, and the force pass's per-row state
   void rebuild_if_needed();
+  // Each existing row's activity and time-step stiffness now (after make_wet, make_dry, new
+  // properties), for the next cycle's Δt.
+  void refresh_timestep_stiffness();
   void force_pass(double dt);
   // The law of motion on the records, with each ball's travel since the
   // neighbour list (and since the live rows) measured as it moves; write_columns: the BallStore's
