@@ -92,7 +92,8 @@ void validate(const StudySettings& s, const std::vector<CaseSpec>& cases) {
     throw InputError(fmt::format("--min-grains must be in [0, 1000000], got {}", s.min_grains));
   for (const CaseSpec& c : cases) {
     if (!(c.confinement >= 0) || !std::isfinite(c.confinement))
-      throw InputError(fmt::format("confinement must be a finite number > 0 Pa, got {:g}", c.confinement));
+      throw InputError(fmt::format("case {}: confinement must be 0 (the test's) or a finite number > 0 Pa, got {:g}", c.name(),
+                                   c.confinement));
     GenesisSpec g = s.genesis;
     g.grading = resolve_grading(c.grading);
     std::tie(g.vessel_radius, g.vessel_height) = vessel_for(s, g.grading);
@@ -242,7 +243,8 @@ std::string StudyResult::summary_markdown() const {
                        c.test.steps, c.seconds);
   }
   out += "\nM_r: resilient modulus, the slope of the least-squares line through the unload branch's points with q in the middle\n"
-         "80 % of q_B..q_A, +- its standard error (inflated for the residuals' serial correlation); secant: the two-point unload\n"
+         "80 % of q_B..q_A, +- its standard error (block jackknife: honest for the ringing's correlated residuals); secant: the\n"
+         "two-point unload "
          "secant (q_A − q_B)/(eps_A − eps_B); reload: the same fit over the reload branch (q_B..q_C);\n"
          "loop: hysteresis, loop area ∮ q d(eps_a) = energy dissipated per unit volume. Z: touching grain-grain contacts per grain\n"
          "(Z packed: after packing; Z: at the test start).\n"
