@@ -159,9 +159,9 @@ int run(const Options& o) {
   if (log)
     *log << fmt::format("hilldem triaxial: {} case{} in a {:.0f} mm x {:.0f} mm vessel{}{}; output {}\n", cases.size(),
                         cases.size() > 1 ? "s" : "", 2e3 * settings.genesis.vessel_radius, 1e3 * settings.genesis.vessel_height,
-                        settings.genesis.vessel_radius == kMemoRadius && settings.genesis.vessel_height == kMemoHeight
-                            ? " (the memo's)"
-                            : " (scaled; --full for the memo's 170 mm x 240 mm)",
+                        o.full || (o.scale_given && o.scale == 1.0)
+                            ? fmt::format(" (full size, {})", lower(o.vessel) == "t307" ? "T 307's" : "the memo's")
+                            : fmt::format(" (scaled by {:g}; --full for the full size)", o.scale),
                         settings.min_grains > 0
                             ? fmt::format(", each grading's scaled up to hold {} grains (--min-grains)", settings.min_grains)
                             : std::string(),
@@ -212,7 +212,7 @@ Command add_triaxial_command(CLI::App& app) {
   cmd->add_option("--material", o->material, "grain-grain model: linear or hill (default hill)");
   cmd->add_flag("--wet", o->wet, "make_wet(suction, moisture gap) at the end of genesis (hill only)");
   cmd->add_option("-o,--output", o->output, "output folder (default out/triaxial, or out/study with --study)");
-  cmd->add_flag("--full", o->full, "the full-size vessel (the memo's 170 mm x 240 mm); every grading in it");
+  cmd->add_flag("--full", o->full, "the full-size vessel (--vessel: the memo's 170 mm x 240 mm by default); every grading in it");
   CLI::Option* scale = cmd->add_option(
       "--scale", o->scale,
       "vessel size relative to the full one (default 0.5, each grading's scaled up to hold --min-grains); every grading in it");
