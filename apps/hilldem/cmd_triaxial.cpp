@@ -24,9 +24,13 @@ namespace hilldem::cli {
 
 namespace {
 
-// Memo vessel: 170 mm x 240 mm. The default specimen is this vessel scaled by kDefaultScale.
+// Memo vessel: 170 mm x 240 mm; AASHTO T 307's specimen for aggregate base: 152 mm x 305 mm (H/D = 2).
+// The default specimen is the memo's vessel scaled by kDefaultScale, each grading's scaled up until it
+// holds kDefaultMinGrains grains (C5n: 0.83; C5b stays at 0.5).
 constexpr double kMemoRadius = 0.085, kMemoHeight = 0.240;
+constexpr double kT307Radius = 0.076, kT307Height = 0.305;
 constexpr double kDefaultScale = 0.5;
+constexpr int kDefaultMinGrains = 500;
 
 struct Options {
   bool study = false;
@@ -36,9 +40,11 @@ struct Options {
   std::string output;
   bool full = false;
   double scale = kDefaultScale;
+  std::string vessel = "memo";
+  int min_grains = -1;  // -1: kDefaultMinGrains unless --scale or --full
   std::int64_t seed = 10000;
   double packing_pressure = 150e3;  // P_m [Pa]
-  double confinement = 150e3;       // σ_c [Pa]
+  std::vector<double> confinements{150e3};  // σ_c [Pa]; more than one: a sweep
   bool pack_linear = false;
   std::vector<double> cycles{0.02, 0.05};  // [%]
   double final_strain = 1.0;                // [%]
@@ -54,6 +60,7 @@ struct Options {
   bool no_plot = false;
   bool pack_only = false;
   bool grading_given = false;  // --grading on the command line
+  bool scale_given = false;    // --scale on the command line
   int threads = 1;
   int jobs = 0;  // 0: the number of cores
   bool quiet = false;
@@ -67,21 +74,32 @@ std::string lower(std::string s) {
 // Options -> settings and cases; every check that can fail does so here, before any work.
 std::pair<StudySettings, std::vector<CaseSpec>> build(const Options& o) {
   StudySettings s;
-  if (o.full && o.scale != kDefaultScale) throw InputError("give either --full or --scale, not both");
+  if (o.full && o.scale_given) throw InputError("give either --full or --scale, not both");
   const double scale = o.full ? 1.0 : o.scale;
   if (!(scale > 0 && scale <= 4)) throw InputError(fmt::format("--scale must be in (0, 4], got {:g}", scale));
-  s.genesis.vessel_radius = kMemoRadius * scale;
-  s.genesis.vessel_height = kMemoHeight * scale;
+  const std::string vessel = lower(o.vessel);
+  if (vessel != "memo" && vessel != "t307")
+    throw InputError("unknown vessel '" + o.vessel + "': choose memo (170 mm x 240 mm) or t307 (152 mm x 305 mm, H/D = 2)");
+  s.genesis.vessel_radius = (vessel == "memo" ? kMemoRadius : kT307Radius) * scale;
+  s.genesis.vessel_height = (vessel == "memo" ? kMemoHeight : kT307Height) * scale;
+  s.min_grains = o.min_grains >= 0 ? o.min_grains : (o.full || o.scale_given ? 0 : kDefaultMinGrains);
   s.genesis.d_mult = o.d_mult;
   if (o.seed < 0) throw InputError(fmt::format("--seed must be >= 0, got {}", o.seed));
   s.genesis.packing.seed = static_cast<std::uint64_t>(o.seed);
-  for (const auto& [name, value] : {std::pair{"--packing-pressure", o.packing_pressure}, std::pair{"--confinement", o.confinement}})
+  std::vector<std::pair<const char*, double>> pressures{{"--packing-pressure", o.packing_pressure}};
+  for (double c : o.confinements) pressures.emplace_back("--confinement", c);
+  if (o.confinements.empty()) throw InputError("--confinement needs at least one value [Pa]");
+  for (const auto& [name, value] : pressures)
     if (!(value > 0) || !std::isfinite(value))
       throw InputError(fmt::format("{} must be a finite number > 0 Pa, got {:g}", name, value));
+  for (std::size_t i = 1; i < o.confinements.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (o.confinements[i] == o.confinements[j])
+        throw InputError(fmt::format("--confinement lists {:g} Pa twice", o.confinements[i]));
   s.genesis.packing.equilibrium.pressure = o.packing_pressure;
   s.finalize = s.genesis.packing.equilibrium;
   s.finalize.ratio = o.finalize_ratio;  // validated with the rest
-  s.triaxial.confinement = o.confinement;
+  s.triaxial.confinement = o.confinements.front();
   s.pack_linear = o.pack_linear;
   s.triaxial.cycle_strains.clear();
   for (double c : o.cycles) s.triaxial.cycle_strains.push_back(c / 100.0);
@@ -118,6 +136,7 @@ std::pair<StudySettings, std::vector<CaseSpec>> build(const Options& o) {
     cases.push_back({grading, m == "hill" ? GrainModel::Hill : GrainModel::Linear, o.wet});
     s.output_dir = o.output.empty() ? "out/triaxial" : o.output;
   }
+  if (o.confinements.size() > 1) cases = sweep_confinements(cases, o.confinements);
   validate(s, cases);
   return {s, cases};
 }
@@ -141,15 +160,21 @@ int run(const Options& o) {
   if (o.threads > 0) omp_set_num_threads(o.threads);  // 0: OpenMP's default (OMP_NUM_THREADS or all cores)
   std::ostream* log = o.quiet ? nullptr : &std::cout;
   if (log)
-    *log << fmt::format("hilldem triaxial: {} case{} in a {:.0f} mm x {:.0f} mm vessel{}; output {}\n", cases.size(),
+    *log << fmt::format("hilldem triaxial: {} case{} in a {:.0f} mm x {:.0f} mm vessel{}{}; output {}\n", cases.size(),
                         cases.size() > 1 ? "s" : "", 2e3 * settings.genesis.vessel_radius, 1e3 * settings.genesis.vessel_height,
-                        settings.genesis.vessel_radius == kMemoRadius ? " (the memo's)" : " (scaled; --full for the memo's 170 mm x 240 mm)",
+                        o.full || (o.scale_given && o.scale == 1.0)
+                            ? fmt::format(" (full size, {})", lower(o.vessel) == "t307" ? "T 307's" : "the memo's")
+                            : fmt::format(" (scaled by {:g}; --full for the full size)", o.scale),
+                        settings.min_grains > 0
+                            ? fmt::format(", each grading's scaled up to hold {} grains (--min-grains)", settings.min_grains)
+                            : std::string(),
                         settings.output_dir);
   if (o.pack_only) {
     const auto t0 = std::chrono::steady_clock::now();
     const std::clock_t c0 = std::clock();
     const std::vector<PackedResult> packed = make_all_packed(settings, cases, true, log);
     std::cout << "\n" << packing_table(packed);
+    std::cout << "\nconverged when " << criterion_text(settings.genesis.packing.equilibrium) << "\n";
     std::cout << fmt::format("\nspecimens: {}/specimens/; {:.0f} s wall, {:.0f} s CPU\n", settings.output_dir,
                              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
                              static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC);
@@ -190,14 +215,24 @@ Command add_triaxial_command(CLI::App& app) {
   cmd->add_option("--material", o->material, "grain-grain model: linear or hill (default hill)");
   cmd->add_flag("--wet", o->wet, "make_wet(suction, moisture gap) at the end of genesis (hill only)");
   cmd->add_option("-o,--output", o->output, "output folder (default out/triaxial, or out/study with --study)");
-  cmd->add_flag("--full", o->full, "the memo's full 170 mm x 240 mm vessel (default: scaled by 0.5, 85 mm x 120 mm)");
-  cmd->add_option("--scale", o->scale, "vessel size relative to the memo's 170 mm x 240 mm (default 0.5)")->check(finite_number());
+  cmd->add_flag("--full", o->full, "the full-size vessel (--vessel: the memo's 170 mm x 240 mm by default); every grading in it");
+  CLI::Option* scale = cmd->add_option(
+      "--scale", o->scale,
+      "vessel size relative to the full one (default 0.5, each grading's scaled up to hold --min-grains); every grading in it")
+      ->check(finite_number());
+  cmd->add_option("--vessel", o->vessel,
+                  "vessel shape at full size: memo (170 mm x 240 mm, the default) or t307 (AASHTO T 307's 152 mm x 305 mm, H/D = 2)");
+  cmd->add_option("--min-grains", o->min_grains,
+                  "scale each grading's vessel up (never down) until it holds this many grains (default 500 without --scale "
+                  "or --full, else 0 = off)")
+      ->check(CLI::Range(0, 1000000));
   cmd->add_option("--seed", o->seed, "random seed of the grain cloud (default 10000, Table 7)");
   cmd->add_option("--packing-pressure", o->packing_pressure,
                   "packing pressure P_m [Pa]: packing, finalization and wetting (default 150e3, Table 7)");
-  cmd->add_option("--confinement", o->confinement,
+  cmd->add_option("--confinement", o->confinements,
                   "confining pressure sigma_c of the triaxial test [Pa] (default 150e3); when it differs from P_m the "
-                  "specimen is first brought to it on every wall");
+                  "specimen is first brought to it on every wall; a comma list (50e3,100e3,150e3) runs every case at each")
+      ->delimiter(',');
   cmd->add_flag("--pack-linear", o->pack_linear,
                 "pack every material with frictionless linear contacts, one packing per grading (the former shared "
                 "packing; a deviation from the memo, which packs each material with its own model)");
@@ -226,8 +261,9 @@ Command add_triaxial_command(CLI::App& app) {
                   "when fewer are left than cores, the ones running take the idle cores; results do not depend on it")
       ->check(CLI::Range(0, 1024));
   cmd->add_flag("-q,--quiet", o->quiet, "only the summary");
-  return {cmd, [o, grading] {
+  return {cmd, [o, grading, scale] {
             o->grading_given = grading->count() > 0;
+            o->scale_given = scale->count() > 0;
             return run(*o);
           }};
 }

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <numbers>
 #include <string>
 
 #include "hilldem/core/error.hpp"
@@ -60,6 +61,39 @@ void expect_at_pressure(const SpecimenState& st, double p, double ratio) {
   EXPECT_LE(st.ratio, ratio);
 }
 
+// The porosity criterion on a synthetic history n(t) = n_inf + a exp(−t/τ), sampled every 50 steps:
+// the change over the last W steps per 1,000 is a e^{−t/τ} (e^{W/τ} − 1) 1000/W, at most the tolerance
+// from t* = τ ln(a (e^{W/τ} − 1) 1000 / (W tol)) on.
+TEST(PorosityHistory, ConvergesWhereTheChangePerThousandStepsFallsBelowTheTolerance) {
+  const double n_inf = 0.40, a = 0.05, tau = 10'000, tol = 2e-5;
+  const std::int64_t window = 5000, every = 50;
+  const double t_star = tau * std::log(a * (std::exp(window / tau) - 1) * 1000 / (window * tol));
+  PorosityHistory h(window);
+  double change = 0.0;
+  std::int64_t first = -1;
+  for (std::int64_t t = 0; t <= 100'000; t += every) {
+    h.add(t, n_inf + a * std::exp(-t / tau));
+    if (t < window) {
+      EXPECT_FALSE(h.change_per_1000(change)) << t;  // not yet a window of history
+      EXPECT_FALSE(h.converged(1.0)) << t;
+      continue;
+    }
+    ASSERT_TRUE(h.change_per_1000(change));
+    const double exact = a * std::exp(-t / tau) * (std::exp(window / tau) - 1) * 1000 / window;
+    EXPECT_NEAR(change, exact, 1e-9 * exact) << t;
+    if (first < 0 && h.converged(tol)) first = t;
+  }
+  EXPECT_GE(first, static_cast<std::int64_t>(t_star));
+  EXPECT_LT(first, static_cast<std::int64_t>(t_star) + every);
+  // A porosity still falling at the rate (0.4164 -> 0.4134 in 20,000 steps: 1.5e-4 per 1,000)
+  // is not converged at the default tolerance.
+  PorosityHistory falling(window);
+  for (std::int64_t t = 0; t <= 20'000; t += every) falling.add(t, 0.4164 - 0.003 * t / 20'000.0);
+  ASSERT_TRUE(falling.change_per_1000(change));
+  EXPECT_NEAR(change, 1.5e-4, 1e-9);
+  EXPECT_FALSE(falling.converged(EquilibriumSettings{}.porosity_change));
+}
+
 TEST(Genesis, HillGrainsPackWithFrictionlessHillContactsAndFinalizationRestoresFriction) {
   const GenesisSpec spec = small_spec(GrainModel::Hill);
   EXPECT_EQ(PackingSettings{}.contact.model, GrainModel::Hill);  // the default: the material's own model
@@ -81,6 +115,14 @@ TEST(Genesis, HillGrainsPackWithFrictionlessHillContactsAndFinalizationRestoresF
     EXPECT_DOUBLE_EQ(s.sim.balls.young_mod[i], 29e9);
     EXPECT_DOUBLE_EQ(s.sim.balls.pois_ratio[i], 0.15);
   }
+  // The packing ended with its porosity converged, and says so.
+  ASSERT_FALSE(s.phases.empty());
+  const PhaseReport& packing = s.phases.back();
+  EXPECT_EQ(packing.name, "packing");
+  EXPECT_GE(packing.porosity_change, 0.0);
+  EXPECT_LE(packing.porosity_change, spec.packing.equilibrium.porosity_change);
+  EXPECT_GE(packing.steps, spec.packing.equilibrium.porosity_window);
+  EXPECT_NE(packing.line().find(fmt::format("dn {:.1e} per 1000 steps", packing.porosity_change)), std::string::npos) << packing.line();
   const PhaseReport f = finalize(s, Class5Material{}, WallContact{}, EquilibriumSettings{}, nullptr);
   EXPECT_EQ(s.material, "fine_Hill");
   const ContactCount fin = check_contacts(s.sim, ModelKind::Hill, 0.4);  // friction restored
@@ -236,6 +278,18 @@ Specimen lattice_specimen(double R, double H, double d_big, double d) {
         add(p, d);
       }
   return s;
+}
+
+// A known packing through measure(): a simple cubic lattice of 4 mm grains (porosity 1 − π/6 = 0.4764
+// in the bulk) in a 100 mm x 80 mm vessel, one 1 mm grain at its centre. The interior (margin D_max =
+// 4 mm) is the bulk's; the vessel's porosity is above it (the gaps the lattice leaves at the curved wall).
+TEST(MeasureRegion, InteriorPorosityOfASimpleCubicLatticeIsTheBulkValue) {
+  const Specimen s = lattice_specimen(0.05, 0.08, 0.001, 0.004);
+  const SpecimenState st = measure(s);
+  ASSERT_EQ(st.interior_margin, SpecimenState::Margin::DMax);
+  EXPECT_DOUBLE_EQ(st.interior_margin_length, 0.004);
+  EXPECT_NEAR(st.interior_porosity, 1 - std::numbers::pi / 6, 0.005) << st.interior_porosity;
+  EXPECT_GT(st.porosity, st.interior_porosity + 0.01) << st.porosity;
 }
 
 TEST(MeasureRegion, InteriorMarginIsDmaxThenD50ThenNotMeasuredAndNeverNan) {

@@ -1,11 +1,13 @@
 // Triaxial test: the loop analysis on known paths, a miniature test with cycles through the engine,
 // finalization, wetting and the saved packed specimen.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
 #include <sstream>
 #include <numbers>
+#include <random>
 
 #include "hilldem/core/error.hpp"
 #include "hilldem/labtests/specimen_io.hpp"
@@ -67,6 +69,87 @@ TEST(LoopTracker, AnUnclosedLoopIsReportedAsSuch) {
   EXPECT_FALSE(loops[0].closed);
   EXPECT_NEAR(loops[0].unload_secant, 36e3 / 1e-4, 1e-3);
   EXPECT_EQ(loops[0].reload_secant, 0.0);
+}
+
+// A loop that rings: straight unload and reload branches of known slopes, with a decaying oscillation
+// after each reversal (1.5 kPa, as the engine's signal) and white noise (0.3 kPa) on top. Returns the
+// tracker's loop.
+LoopResult ringing_loop(double m_unload, double m_reload, unsigned seed) {
+  std::mt19937_64 gen(seed);
+  std::normal_distribution<double> noise(0.0, 300.0);
+  LoopTracker t;
+  const double ea = 1e-3, qa = 100e3, qb = 10e3;
+  const double eb = ea - (qa - qb) / m_unload;
+  const int n = 3000;
+  auto ring = [](int k) { return 1.5e3 * std::exp(-k / 400.0) * std::sin(2 * std::numbers::pi * k / 90.0); };
+  for (int k = 0; k <= 200; ++k) t.add(TriaxialPhase::Load, 1, ea * k / 200, qa * k / 200);
+  for (int k = 1; k <= n; ++k) {
+    const double e = ea + (eb - ea) * k / n;
+    t.add(TriaxialPhase::Unload, 1, e, qa - m_unload * (ea - e) + ring(k) + noise(gen));
+  }
+  for (int k = 1; k <= n + 5; ++k) {
+    const double e = eb + (ea - eb) * k / n;
+    t.add(TriaxialPhase::Reload, 1, e, qb + m_reload * (e - eb) + ring(k) + noise(gen));
+  }
+  t.add(TriaxialPhase::Load, 2, ea + 1e-5, qa);
+  const auto loops = t.loops();
+  EXPECT_EQ(loops.size(), 1u);
+  return loops.at(0);
+}
+
+TEST(LoopTracker, FittedModulusRecoversTheSlopeOfARingingLoopWithinItsUncertainty) {
+  const double mu = 250e6, mr = 270e6;  // [Pa]
+  const LoopResult l = ringing_loop(mu, mr, 7);
+  ASSERT_TRUE(l.unload.valid);
+  ASSERT_TRUE(l.reload.valid);
+  EXPECT_TRUE(l.closed);
+  // The fitted part: the middle 80 % of q_B..q_A, most of the branch's 3000 points.
+  EXPECT_GT(l.unload.points, 2000u);
+  EXPECT_LT(l.unload.points, 2800u);
+  EXPECT_LE(std::abs(l.unload.slope - mu), 2 * l.unload.slope_se) << l.unload.slope << " +- " << l.unload.slope_se;
+  EXPECT_LE(std::abs(l.reload.slope - mr), 2 * l.reload.slope_se) << l.reload.slope << " +- " << l.reload.slope_se;
+  // An uncertainty that says something: under 2 % of the slope, and larger than the textbook one,
+  // which takes the ringing's correlated residuals for independent ones.
+  EXPECT_LT(l.unload.slope_se, 0.02 * mu);
+  EXPECT_GT(l.unload.slope_se, 1.5 * l.unload.ols_se);
+  // The two-point secant is kept beside the fit.
+  EXPECT_NEAR(l.unload_secant, (l.q_a - l.q_b) / (l.eps_a - l.eps_b), 1e-9 * mu);
+  TriaxialResult res;
+  res.loops = {l};
+  EXPECT_NE(res.loops_text().find(fit_text(l.unload) + " MPa, unload secant"), std::string::npos) << res.loops_text();
+}
+
+TEST(LoopTracker, FittedModulusUncertaintyCoversTheTrueSlope) {
+  // Over many noise draws, the true slope lies within two standard errors in most (about 95 % for
+  // an honest uncertainty).
+  int covered = 0;
+  const int draws = 40;
+  for (int k = 0; k < draws; ++k) {
+    const LoopResult l = ringing_loop(250e6, 270e6, 100 + k);
+    covered += std::abs(l.unload.slope - 250e6) <= 2 * l.unload.slope_se;
+  }
+  EXPECT_GE(covered, 34) << covered << " of " << draws;
+}
+
+TEST(LineFit, StandardErrorOfIndependentNoiseAndTooFewPoints) {
+  // White noise: the jackknife agrees with the textbook s_b = σ / sqrt(Σ (x − x̄)²) (within its own
+  // scatter, about 16 % for 20 blocks).
+  std::mt19937_64 gen(3);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  std::vector<double> x, y;
+  for (int i = 0; i < 1000; ++i) x.push_back(i * 1e-3), y.push_back(5.0 + 2.0 * i * 1e-3 + noise(gen));
+  const LineFit f = fit_line(x, y);
+  ASSERT_TRUE(f.valid);
+  double sxx = 0, mx = 0.4995;
+  for (double v : x) sxx += (v - mx) * (v - mx);
+  EXPECT_NEAR(f.ols_se, 1.0 / std::sqrt(sxx), 0.1 / std::sqrt(sxx));
+  EXPECT_NEAR(f.slope_se, f.ols_se, 0.4 * f.ols_se);
+  EXPECT_EQ(f.blocks, 20);
+  EXPECT_NEAR(f.slope, 2.0, 3 * f.slope_se);
+  EXPECT_FALSE(fit_line({1.0, 2.0}, {1.0, 2.0}).valid);
+  EXPECT_FALSE(fit_line(std::vector<double>(8, 1.0), std::vector<double>(8, 2.0)).valid);  // fewer than 9 points
+  EXPECT_FALSE(fit_line(std::vector<double>(9, 1.0), std::vector<double>(9, 2.0)).valid);  // x all equal
+  EXPECT_EQ(fit_text(fit_line({1.0, 2.0}, {1.0, 2.0})), "n/a (2 points in the fitted part)");
 }
 
 TEST(TriaxialSettings, BadValuesAreRefusedBeforeAnyWork) {
@@ -166,7 +249,7 @@ TEST(Triaxial, MiniatureTestRunsTheCyclesAndComputesTheModuli) {
   EXPECT_EQ(csv.substr(0, csv.find('\n')),
             "step,time[s],phase,cycle,eps_a[-],eps_r[-],eps_v[-],sigma_a[Pa],sigma_r[Pa],q[Pa],sigma_top[Pa],sigma_bottom[Pa],"
             "porosity[-],coordination[-],platen_mismatch[-]");
-  EXPECT_NE(r.loops_text().find("resilient modulus M_r (unload secant)"), std::string::npos);
+  EXPECT_NE(r.loops_text().find("resilient modulus M_r (unload fit)"), std::string::npos);
 
   // Quasi-static: the platens carry the same force.
   EXPECT_LT(r.worst_platen_mismatch, 0.05);
@@ -281,6 +364,191 @@ TEST(SpecimenFile, SavedPackedSpecimenReloadsToTheSameState) {
   EXPECT_THROW(parse_packed_specimen("format,something-else,1\n", "x.csv"), InputError);
 }
 
+// Broken specimen files are refused like scenarios: the file, the line, the column, the range, the value.
+std::vector<std::string> split_lines(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string l; std::getline(in, l);) out.push_back(l);
+  return out;
+}
+std::string join_lines(const std::vector<std::string>& lines) {
+  std::string out;
+  for (const std::string& l : lines) out += l + "\n";
+  return out;
+}
+std::vector<std::string> cells(const std::string& line) {
+  std::vector<std::string> out;
+  std::stringstream ss(line);
+  for (std::string c; std::getline(ss, c, ',');) out.push_back(c);
+  return out;
+}
+std::string row(const std::vector<std::string>& c) {
+  std::string out;
+  for (const std::string& x : c) out += (out.empty() ? "" : ",") + x;
+  return out;
+}
+std::string refusal(const std::string& text) {
+  try {
+    parse_packed_specimen(text, "broken.csv");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "accepted";
+}
+
+TEST(SpecimenFile, PhysicallyBrokenSpecimensAreRefusedWithTheLineAndRange) {
+  const std::string text = packed_specimen_text(testing::mini_packed(), testing::mini_spec().packing);
+  std::vector<std::string> lines = split_lines(text);
+  std::size_t first = 0;  // the first grain row
+  while (cells(lines[first])[0] != "id") ++first;
+  ++first;
+  const std::string at = fmt::format("broken.csv:{}:", first + 1);
+  auto with = [&](std::size_t line, int column, const std::string& value) {
+    std::vector<std::string> l = lines;
+    auto c = cells(l[line]);
+    c[column] = value;
+    l[line] = row(c);
+    return join_lines(l);
+  };
+  EXPECT_EQ(refusal(text), "accepted");
+  std::string e = refusal(with(first, 4, "1e-300"));
+  EXPECT_NE(e.find(at), std::string::npos) << e;
+  EXPECT_NE(e.find("radius[m] must be in [1e-06, 1], got 1e-300"), std::string::npos) << e;
+  e = refusal(with(first, 7, "0.7"));
+  EXPECT_NE(e.find("pois_ratio[-] must be in (-1, 0.5], got 0.7"), std::string::npos) << e;
+  e = refusal(with(first, 6, "1e300"));
+  EXPECT_NE(e.find("young_mod[Pa] must be in [100000, 1.2e+12], got 1e+300"), std::string::npos) << e;
+  e = refusal(with(first, 5, "0"));
+  EXPECT_NE(e.find("density[kg/m3] must be in [100, 25000], got 0"), std::string::npos) << e;
+  // Two grains at one centre: the second row takes the first row's position.
+  {
+    std::vector<std::string> l = lines;
+    auto a = cells(l[first]), b = cells(l[first + 1]);
+    b[1] = a[1], b[2] = a[2], b[3] = a[3];
+    l[first + 1] = row(b);
+    e = refusal(join_lines(l));
+    EXPECT_NE(e.find(fmt::format("broken.csv:{}: grains {} and {} (line {}) have one centre", first + 2, a[0], b[0], first + 1)),
+              std::string::npos)
+        << e;
+  }
+  // A grain grown into its neighbours: the grain nearest the vessel's centre, its radius × 1.3.
+  {
+    const Specimen& s = testing::mini_packed();
+    const double zc = 0.5 * (s.vessel.bottom_z(s.sim) + s.vessel.top_z(s.sim));
+    std::size_t best = first;
+    double best_d = 1e9;
+    for (std::size_t i = first; i < lines.size(); ++i) {
+      const auto c = cells(lines[i]);
+      const double d = std::hypot(std::stod(c[1]), std::stod(c[2]), std::stod(c[3]) - zc);
+      if (d < best_d) best_d = d, best = i;
+    }
+    e = refusal(with(best, 4, fmt::format("{}", 1.3 * std::stod(cells(lines[best])[4]))));
+    EXPECT_NE(e.find("overlap by"), std::string::npos) << e;
+    EXPECT_NE(e.find("of the smaller diameter; at most 1 % is a packed state"), std::string::npos) << e;
+    EXPECT_NE(e.find(cells(lines[best])[0]), std::string::npos) << e;
+  }
+  // A grain pushed through the lateral wall (its centre still inside).
+  {
+    const Specimen& s = testing::mini_packed();
+    const double R = s.vessel.radius(s.sim);
+    const auto c = cells(lines[first]);
+    const double r = std::stod(c[4]);
+    std::vector<std::string> l = lines;
+    auto m = c;
+    m[1] = fmt::format("{}", R - 0.5 * r), m[2] = "0";
+    l[first] = row(m);
+    e = refusal(join_lines(l));
+    EXPECT_NE(e.find(at), std::string::npos) << e;
+    EXPECT_NE(e.find("beyond a vessel wall"), std::string::npos) << e;
+  }
+}
+
+// States and results that cannot be physical are named (run_study then fails with exit status 1).
+// A sweep runs every case at each confinement, named by it; the findings compare cases of one confinement.
+TEST(Study, ConfinementSweepNamesTheCasesAndGroupsTheFindings) {
+  const auto cases = sweep_confinements(memo_cases(), {50e3, 100e3});
+  ASSERT_EQ(cases.size(), 10u);
+  EXPECT_EQ(cases[0].name(), "C5n_Linear_50kPa");
+  EXPECT_EQ(cases[9].name(), "C5b_Hill_wet_100kPa");
+  EXPECT_EQ(memo_cases()[3].name(), "C5b_Hill");  // no sweep: no suffix
+  StudySettings st;
+  EXPECT_DOUBLE_EQ(confinement_of(st, cases[9]), 100e3);
+  EXPECT_DOUBLE_EQ(confinement_of(st, memo_cases()[0]), st.triaxial.confinement);
+  StudyResult r;
+  for (const CaseSpec& c : cases) {
+    CaseResult cr;
+    cr.spec = c;
+    cr.grading.name = c.grading;
+    LoopResult l;
+    l.closed = true;
+    l.loop_area = c.model == GrainModel::Hill ? 2.0 : 1.0;
+    l.unload.valid = true;
+    l.unload.slope = (c.grading == "C5b" ? 200e6 : 100e6) * c.confinement / 100e3;
+    l.unload.slope_se = 1e6;
+    cr.test.loops = {l};
+    cr.test.peak_q = c.confinement;
+    r.cases.push_back(cr);
+  }
+  const auto f = r.findings();
+  ASSERT_EQ(f.size(), 10u);  // five claims at each of two confinements
+  EXPECT_EQ(f[0].rfind("at sigma_c = 50 kPa: hysteresis loops larger", 0), 0u) << f[0];
+  EXPECT_EQ(f[5].rfind("at sigma_c = 100 kPa: hysteresis loops larger", 0), 0u) << f[5];
+  // Within one confinement C5b is stiffer (across them a 50 kPa C5b would not be).
+  EXPECT_NE(f[1].find("HOLDS (2 of 2 comparisons)"), std::string::npos) << f[1];
+  EXPECT_NE(f[6].find("M_r C5b 200.0 +- 1.0 vs C5n 100.0 +- 1.0 MPa"), std::string::npos) << f[6];
+}
+
+// The default vessel: a grading holding fewer than min_grains gets the same shape scaled up.
+TEST(Study, MinGrainsScalesUpTheVesselOfACoarseGrading) {
+  StudySettings st;
+  st.genesis.vessel_radius = 0.0425;
+  st.genesis.vessel_height = 0.120;
+  const Grading n = grading_c5n(), b = grading_c5b();
+  const double n_half = expected_grains(n, 1.0, 0.0425, 0.120, 0.58);
+  EXPECT_GT(n_half, 90);  // about 110 grains of 14-20 mm in the half-size vessel
+  EXPECT_LT(n_half, 130);
+  EXPECT_EQ(vessel_for(st, n), std::make_pair(0.0425, 0.120));  // min_grains 0: as given
+  st.min_grains = 500;
+  const auto [rn, hn] = vessel_for(st, n);
+  EXPECT_NEAR(rn / 0.0425, hn / 0.120, 1e-12);  // the same shape
+  EXPECT_NEAR(expected_grains(n, 1.0, rn, hn, 0.58), 500, 1e-6);
+  EXPECT_EQ(vessel_for(st, b), std::make_pair(0.0425, 0.120));  // C5b holds ~1,700: never scaled down
+}
+
+TEST(Study, ImpossibleStatesAndResultsAreNamed) {
+  SpecimenState st;
+  st.porosity = 0.35;
+  st.radial_stress = st.bottom_stress = st.top_stress = 151e3;
+  EXPECT_TRUE(impossible_state(st, 150e3).empty());
+  st.radial_stress = 215817e3;  // a grain grown into its neighbours
+  auto bad = impossible_state(st, 150e3);
+  ASSERT_EQ(bad.size(), 1u);
+  EXPECT_NE(bad[0].find("sigma_r 215817 kPa, more than 25 % from the target 150 kPa"), std::string::npos) << bad[0];
+  TriaxialResult r;
+  LoopResult l;
+  l.cycle = 1;
+  l.q_a = 30e3;
+  l.closed = true;
+  l.loop_area = 2.0;
+  l.damping_ratio = 0.05;
+  r.loops = {l};
+  r.peak_q = 200e3;
+  EXPECT_TRUE(impossible_results(r).empty());
+  r.loops[0].loop_area = -1.5;
+  r.loops[0].damping_ratio = -0.02;
+  bad = impossible_results(r);
+  ASSERT_EQ(bad.size(), 2u);
+  EXPECT_NE(bad[0].find("cycle 1: loop area -1.5 J/m^3 < 0"), std::string::npos) << bad[0];
+  EXPECT_NE(bad[1].find("damping ratio -0.02 < 0"), std::string::npos) << bad[1];
+  r.loops[0] = l;
+  r.loops[0].q_a = -4e3;
+  r.peak_q = -1e3;
+  bad = impossible_results(r);
+  ASSERT_EQ(bad.size(), 2u);
+  EXPECT_NE(bad[0].find("q_A = -4 kPa under compression"), std::string::npos) << bad[0];
+  EXPECT_NE(bad[1].find("peak deviator -1 kPa"), std::string::npos) << bad[1];
+}
+
 // ---------------------------------------------------------------------------------------------------
 // The study driver on the miniature specimen: files, summary, findings.
 
@@ -379,6 +647,10 @@ TEST(Study, FindingsAreComputedFromTheNumbers) {
     LoopResult l;
     l.loop_area = area;
     l.unload_secant = mr;
+    l.unload.slope = mr;
+    l.unload.slope_se = 1e6;  // 1 MPa
+    l.unload.points = 100;
+    l.unload.valid = true;
     l.closed = true;
     c.test.loops = {l};
     c.test.peak_q = peak;
@@ -399,6 +671,19 @@ TEST(Study, FindingsAreComputedFromTheNumbers) {
   // A claim that holds for some comparisons only says so.
   r.cases[1].test.loops[0].loop_area = 0.5;  // C5n hill loop now smaller than linear's
   EXPECT_NE(r.findings()[0].find("HOLDS IN PART (1 of 2 comparisons)"), std::string::npos) << r.findings()[0];
+  // Moduli that differ by less than twice the standard error of their difference (1.4 MPa) are
+  // within noise, whichever is larger.
+  r.cases[4].test.loops[0].unload.slope = 201e6;  // wet 201 +- 1 vs dry 200 +- 1 MPa
+  EXPECT_NE(r.findings()[4].find("WITHIN NOISE (1 of 1 comparisons within 2 standard errors)"), std::string::npos) << r.findings()[4];
+  EXPECT_NE(r.findings()[4].find("wet 201.0 +- 1.0 vs dry 200.0 +- 1.0 MPa"), std::string::npos) << r.findings()[4];
+  r.cases[4].test.loops[0].unload.slope = 203e6;  // beyond 2 x 1.41 MPa
+  EXPECT_NE(r.findings()[4].find("HOLDS (1 of 1 comparisons)"), std::string::npos) << r.findings()[4];
+  // The same M_r with a large uncertainty: within noise.
+  r.cases[4].test.loops[0].unload.slope_se = 3e6;
+  EXPECT_NE(r.findings()[4].find("WITHIN NOISE"), std::string::npos) << r.findings()[4];
+  // A C5n fit too uncertain to tell: that stiffness comparison is within noise, the claim holds in part.
+  r.cases[0].test.loops[0].unload.slope_se = 40e6;  // C5n linear 100 +- 40 vs C5b linear 150 +- 1
+  EXPECT_NE(r.findings()[1].find("HOLDS IN PART (1 of 2 comparisons; 1 within noise)"), std::string::npos) << r.findings()[1];
 }
 
 }  // namespace

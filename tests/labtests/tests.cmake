@@ -72,7 +72,7 @@ add_test(NAME cli.triaxial_refused_run_writes_nothing
           $<TARGET_FILE:hilldem> ${HILLDEM_TRIAXIAL_OUT}/refused)
 # A miniature run end to end from the stored packed specimen: finalize, wet, one cycle (a few seconds).
 add_test(NAME cli.triaxial_miniature_case_exits_0
-  COMMAND ${HILLDEM_EXPECT_EXIT} --stdout "resilient modulus M_r (unload secant)" --stdout "| fine_Hill_wet |"
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stdout "resilient modulus M_r (unload fit)" --stdout "| fine_Hill_wet |"
           --stdout "wet contacts" --stdout "summary:"
           0 $<TARGET_FILE:hilldem> triaxial --specimen ${HILLDEM_TEST_DATA}/labtests/mini_packed.csv
             --grading ${HILLDEM_TEST_DATA}/labtests/fine.csv --wet --cycles 0.02 --final-strain 0.1 --strain-rate 0.1
@@ -111,3 +111,49 @@ add_test(NAME cli.triaxial_plot_script_writes_figures
           ${PROJECT_SOURCE_DIR}/scripts/plot_triaxial.py ${HILLDEM_TRIAXIAL_OUT}/mini)
 set_tests_properties(cli.triaxial_miniature_case_exits_0 PROPERTIES FIXTURES_SETUP triaxial_mini)
 set_tests_properties(cli.triaxial_plot_script_writes_figures PROPERTIES FIXTURES_REQUIRED triaxial_mini TIMEOUT 120 LABELS "cli;labtests")
+# Physically broken specimen files (tests/cli/broken_specimen.sh makes them from the miniature one):
+# refused with exit status 2 naming the file, line, column, range and value; a packed state far from
+# the file's pressure fails with exit status 1 and the reason, no summary.
+set(HILLDEM_BROKEN_SPECIMEN ${CMAKE_CURRENT_SOURCE_DIR}/cli/broken_specimen.sh)
+foreach(case "one_centre|2|have one centre" "grown|2|of the smaller diameter; at most 1 % is a packed state"
+        "poisson|2|pois_ratio[-] must be in (-1, 0.5], got 0.7" "modulus|2|young_mod[Pa] must be in [100000, 1.2e+12], got 1e+300"
+        "tiny|2|radius[m] must be in [1e-06, 1], got 1e-300"
+        "pressure|1|the packed specimen is physically impossible: sigma_r 149.885 kPa, more than 25 % from the target 1.5 kPa")
+  string(REPLACE "|" ";" parts "${case}")
+  list(GET parts 0 mode)
+  list(GET parts 1 status)
+  list(GET parts 2 text)
+  set(file ${HILLDEM_TRIAXIAL_OUT}/broken/${mode}.csv)
+  add_test(NAME cli.triaxial_broken_specimen_${mode}_exits_${status}
+    COMMAND bash -c "bash \"$0\" \"$1\" \"$2\" \"$3\" && shift 4 && exec \"$@\""
+            ${HILLDEM_BROKEN_SPECIMEN} ${mode} ${HILLDEM_TEST_DATA}/labtests/mini_packed.csv ${file}
+            ${HILLDEM_EXPECT_EXIT} --stderr "${text}" --stderr "${file}" --not-stdout "| fine_Hill |"
+            ${status} $<TARGET_FILE:hilldem> triaxial --specimen ${file} --grading ${HILLDEM_TEST_DATA}/labtests/fine.csv
+            --cycles 0.02 --final-strain 0.04 --strain-rate 0.1 --final-strain-rate 0.5 --threads 1 --no-plot
+            -o ${HILLDEM_TRIAXIAL_OUT}/broken/out_${mode})
+  set_tests_properties(cli.triaxial_broken_specimen_${mode}_exits_${status} PROPERTIES TIMEOUT 120 LABELS "cli;labtests")
+endforeach()
+# Options: a sweep of confinements, the T 307 vessel, the minimum grain count; bad values exit 2.
+add_test(NAME cli.triaxial_confinement_sweep_runs_each_case_at_each
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stdout "| fine_Hill_100kPa |" --stdout "| fine_Hill_150kPa |" --stdout "triaxial: confinement 100 kPa"
+          --not-stdout "nan"
+          0 $<TARGET_FILE:hilldem> triaxial --specimen ${HILLDEM_TEST_DATA}/labtests/mini_packed.csv
+            --grading ${HILLDEM_TEST_DATA}/labtests/fine.csv --confinement 100e3,150e3 --cycles 0.02
+            --final-strain 0.04 --strain-rate 0.1 --final-strain-rate 0.5 --threads 1 --jobs 1 --no-plot -o ${HILLDEM_TRIAXIAL_OUT}/sweep)
+add_test(NAME cli.triaxial_repeated_confinement_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "--confinement lists 100000 Pa twice" --not-stdout "cloud"
+          2 $<TARGET_FILE:hilldem> triaxial --confinement 100e3,100e3 -o ${HILLDEM_TRIAXIAL_OUT}/bad17)
+add_test(NAME cli.triaxial_negative_confinement_in_a_sweep_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "--confinement must be a finite number > 0 Pa, got -5" --not-stdout "cloud"
+          2 $<TARGET_FILE:hilldem> triaxial --confinement=100e3,-5 -o ${HILLDEM_TRIAXIAL_OUT}/bad18)
+add_test(NAME cli.triaxial_unknown_vessel_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "unknown vessel 'cube': choose memo (170 mm x 240 mm) or t307" --not-stdout "cloud"
+          2 $<TARGET_FILE:hilldem> triaxial --vessel cube -o ${HILLDEM_TRIAXIAL_OUT}/bad19)
+# The T 307 shape (H/D = 2) scaled by 0.15: 23 mm x 46 mm.
+add_test(NAME cli.triaxial_t307_vessel_has_h_over_d_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stdout "in a 23 mm x 46 mm vessel" --not-stdout "nan"
+          0 $<TARGET_FILE:hilldem> triaxial --pack-only --vessel t307 --grading ${HILLDEM_TEST_DATA}/labtests/fine.csv --scale 0.15
+            --seed 42 --threads 1 -o ${HILLDEM_TRIAXIAL_OUT}/t307)
+set_tests_properties(cli.triaxial_confinement_sweep_runs_each_case_at_each cli.triaxial_repeated_confinement_exits_2
+  cli.triaxial_negative_confinement_in_a_sweep_exits_2 cli.triaxial_unknown_vessel_exits_2 cli.triaxial_t307_vessel_has_h_over_d_2
+  PROPERTIES TIMEOUT 120 LABELS "cli;labtests")

@@ -94,11 +94,42 @@ void validate(const GenesisSpec& s) {
   check_range(e.ratio > 0 && e.ratio < 1, "equilibrium ratio", e.ratio, "in (0, 1)");
   check_range(e.servo_gain > 0 && e.servo_gain <= 1, "servo gain", e.servo_gain, "in (0, 1]");
   check_range(e.wall_speed_limit > 0 && std::isfinite(e.wall_speed_limit), "wall speed limit [m/s]", e.wall_speed_limit, "> 0");
+  check_range(e.porosity_change > 0 && e.porosity_change < 1, "porosity change per 1,000 steps", e.porosity_change, "in (0, 1)");
+  check_range(e.porosity_window >= 1000, "porosity window [steps]", static_cast<double>(e.porosity_window), ">= 1000");
   double d_max = 0.0;
   for (const GradingBin& b : s.grading.bins) d_max = std::max(d_max, b.d_upper * s.d_mult);
   if (d_max >= std::min(2 * s.vessel_radius, s.vessel_height))
     throw InputError(fmt::format("the largest grain ({:g} mm) does not fit in the vessel ({:g} mm x {:g} mm)",
                                  d_max * 1e3, 2e3 * s.vessel_radius, 1e3 * s.vessel_height));
+}
+
+std::string criterion_text(const EquilibriumSettings& e) {
+  return fmt::format("every wall within {:g} % of {:g} kPa, mean unbalanced-force ratio (per body) <= {:g}, vessel porosity "
+                     "changing by <= {:g} per 1,000 steps over the last {} steps (checked every {} steps)",
+                     100 * e.pressure_tolerance, e.pressure / 1e3, e.ratio, e.porosity_change, e.porosity_window, e.check_every);
+}
+
+void PorosityHistory::add(std::int64_t step, double porosity) {
+  samples_.emplace_back(step, porosity);
+  // Keep the newest sample at least a window old and everything after it.
+  std::size_t keep = 0;
+  for (std::size_t i = 0; i < samples_.size(); ++i)
+    if (samples_[i].first <= step - window_) keep = i;
+  if (keep > 0) samples_.erase(samples_.begin(), samples_.begin() + static_cast<std::ptrdiff_t>(keep));
+}
+
+bool PorosityHistory::change_per_1000(double& out) const {
+  if (samples_.size() < 2) return false;
+  const auto& [s1, n1] = samples_.back();
+  const auto& [s0, n0] = samples_.front();
+  if (s1 - s0 < window_ || s1 <= s0) return false;
+  out = std::abs(n1 - n0) * 1000.0 / static_cast<double>(s1 - s0);
+  return true;
+}
+
+bool PorosityHistory::converged(double tolerance) const {
+  double c = 0.0;
+  return change_per_1000(c) && c <= tolerance;
 }
 
 std::string interior_text(const SpecimenState& s) {
@@ -125,9 +156,10 @@ double volume_median_diameter(std::vector<double> d) {
 
 std::string PhaseReport::line() const {
   return fmt::format("{:<22} {:>8} steps {:>7.1f} s  n {:.4f} (interior {})  Z {:.3f}  sigma_r {:.2f} kPa  sigma_bottom {:.2f} kPa  "
-                     "sigma_top {:.2f} kPa  ratio {:.2e}",
+                     "sigma_top {:.2f} kPa  ratio {:.2e}{}",
                      name, steps, seconds, state.porosity, interior_text(state), state.coordination, state.radial_stress / 1e3,
-                     state.bottom_stress / 1e3, state.top_stress / 1e3, state.ratio);
+                     state.bottom_stress / 1e3, state.top_stress / 1e3, state.ratio,
+                     porosity_change >= 0 ? fmt::format("  dn {:.1e} per 1000 steps", porosity_change) : std::string());
 }
 
 std::vector<double> Specimen::diameters() const {
@@ -309,27 +341,40 @@ PhaseReport servo_equilibrium(Specimen& s, const EquilibriumSettings& e, const s
   const std::int64_t progress_every = 20000;
   std::int64_t next_progress = start + progress_every;
   auto within = [&](double stress) { return std::abs(stress - e.pressure) <= e.pressure_tolerance * e.pressure; };
+  double solid = 0.0;
+  for (double r : sim.balls.radius) solid += 4.0 / 3.0 * std::numbers::pi * r * r * r;
+  auto porosity = [&] { return 1.0 - solid / s.vessel.volume(sim); };
+  PorosityHistory history(e.porosity_window);
+  history.add(sim.steps, porosity());
   for (;;) {
     sim.cycle(std::max<std::int64_t>(1, e.check_every));
+    history.add(sim.steps, porosity());
     const double sr = s.vessel.radial_stress(sim), sb = s.vessel.bottom_stress(sim), st = s.vessel.top_stress(sim);
-    if (within(sr) && within(sb) && within(st) && sim.mean_unbalanced_ratio() <= e.ratio) break;
+    if (within(sr) && within(sb) && within(st) && sim.mean_unbalanced_ratio() <= e.ratio && history.converged(e.porosity_change))
+      break;
     if (log && sim.steps >= next_progress) {
       next_progress += progress_every;
-      *log << fmt::format("  {} step {:>8}: n {:.4f}  sigma_r {:.1f}  sigma_b {:.1f}  sigma_t {:.1f} kPa  ratio {:.2e}  dt {:.3g} s\n",
-                          name, sim.steps - start, measure(s).porosity, sr / 1e3, sb / 1e3, st / 1e3,
-                          sim.mean_unbalanced_ratio(), sim.last_dt);
+      double dn = 0.0;
+      const bool have = history.change_per_1000(dn);
+      *log << fmt::format("  {} step {:>8}: n {:.4f}  sigma_r {:.1f}  sigma_b {:.1f}  sigma_t {:.1f} kPa  ratio {:.2e}  dn {} per 1000 steps  "
+                          "dt {:.3g} s\n",
+                          name, sim.steps - start, porosity(), sr / 1e3, sb / 1e3, st / 1e3, sim.mean_unbalanced_ratio(),
+                          have ? fmt::format("{:.1e}", dn) : std::string("n/a"), sim.last_dt);
       log->flush();
     }
     if (sim.steps - start >= e.max_steps) {
       s.vessel.stop(sim);
-      throw RunError(fmt::format("{}: wall pressures not within {:g} % of {:g} kPa with ratio <= {:g} after {} steps "
-                                 "(sigma_r {:.2f}, sigma_bottom {:.2f}, sigma_top {:.2f} kPa, ratio {:.3g})",
-                                 name, 100 * e.pressure_tolerance, e.pressure / 1e3, e.ratio, e.max_steps, sr / 1e3,
-                                 sb / 1e3, st / 1e3, sim.mean_unbalanced_ratio()));
+      double dn = 0.0;
+      const bool have = history.change_per_1000(dn);
+      throw RunError(fmt::format("{}: not converged after {} steps ({}): sigma_r {:.2f}, sigma_bottom {:.2f}, sigma_top {:.2f} kPa, "
+                                 "ratio {:.3g}, porosity change {} per 1,000 steps",
+                                 name, e.max_steps, criterion_text(e), sr / 1e3, sb / 1e3, st / 1e3, sim.mean_unbalanced_ratio(),
+                                 have ? fmt::format("{:.2g}", dn) : std::string("n/a")));
     }
   }
   s.vessel.stop(sim);
   PhaseReport r{name, sim.steps - start, seconds_since(t0), measure(s)};
+  history.change_per_1000(r.porosity_change);
   if (log) *log << r.line() << std::endl;
   s.phases.push_back(r);
   return r;
@@ -340,10 +385,10 @@ Specimen pack_specimen(const GenesisSpec& spec, std::ostream* log) {
   Specimen s = make_cloud(spec);
   if (log)
     *log << fmt::format("cloud: {} grains of {} at porosity {:.3f} in a {:.0f} mm x {:.0f} mm vessel (seed {}, {:.1f} s); "
-                        "packing contacts {} with friction {:g}\n",
+                        "packing contacts {} with friction {:g}; converged when {}\n",
                         s.sim.balls.size(), spec.grading.name, measure(s).porosity, 2e3 * spec.vessel_radius,
                         1e3 * spec.vessel_height, spec.packing.seed, seconds_since(t0), to_string(spec.packing.contact.model),
-                        spec.packing.contact.fric);
+                        spec.packing.contact.fric, criterion_text(spec.packing.equilibrium));
   relax_cloud(s, spec.packing, log);
   servo_equilibrium(s, spec.packing.equilibrium, "packing", log);
   return s;

@@ -16,15 +16,39 @@
 
 namespace hilldem {
 
-// Servo-controlled equilibrium of the three vessel walls at one pressure.
+// Servo-controlled equilibrium of the three vessel walls at one pressure. Converged when, at a check,
+// all three hold (lab-tests.md §3.4): every wall within ε_P·P of P; the mean unbalanced-force ratio
+// (Simulation::mean_unbalanced_ratio, per body) at most `ratio`; and the vessel porosity changed by at
+// most porosity_change per 1,000 steps over the last porosity_window steps (PorosityHistory).
 struct EquilibriumSettings {
   double pressure = 150e3;           // target wall pressure [Pa] (P_m)
   double pressure_tolerance = 1e-2;  // ε_P: every wall within ε_P·P of P [-]
   double ratio = 8e-3;               // static equilibrium: mean unbalanced-force ratio ≤ this [-]
+  double porosity_change = 2e-5;     // |Δn| per 1,000 steps at most this [-] [ours]
+  std::int64_t porosity_window = 5000;  // steps Δn is taken over [ours]
   double servo_gain = 0.5;           // α_s [-]
   double wall_speed_limit = 1.0;     // v_lim [m/s]
   std::int64_t check_every = 50;     // cycles between convergence checks
   std::int64_t max_steps = 4'000'000;
+};
+
+// The convergence criterion in words, for logs and summaries.
+std::string criterion_text(const EquilibriumSettings& e);
+
+// The vessel porosity along a servo equilibrium, sampled at its checks: how much it still changes.
+class PorosityHistory {
+ public:
+  explicit PorosityHistory(std::int64_t window) : window_(window) {}
+  void add(std::int64_t step, double porosity);
+  // |n(now) − n(then)| × 1000 / (now − then) [-] per 1,000 steps, `then` the latest sample at least
+  // `window` steps before the newest; false until the samples span the window.
+  bool change_per_1000(double& out) const;
+  // The history spans the window and the change is at most `tolerance` per 1,000 steps.
+  bool converged(double tolerance) const;
+
+ private:
+  std::int64_t window_;
+  std::vector<std::pair<std::int64_t, double>> samples_;  // (step, porosity), steps increasing
 };
 
 struct PackingSettings {
@@ -80,6 +104,9 @@ struct PhaseReport {
   std::int64_t steps = 0;    // cycles
   double seconds = 0.0;      // wall-clock
   SpecimenState state;       // at the end
+  // Servo equilibria: the vessel porosity's change per 1,000 steps at the end [-] (its convergence);
+  // negative where not measured (the cloud relaxation).
+  double porosity_change = -1.0;
   std::string line() const;  // one console line
 };
 

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -21,6 +23,48 @@ std::string trim(const std::string& s) {
   if (b == std::string::npos) return "";
   const auto e = s.find_last_not_of(" \t\r");
   return s.substr(b, e - b + 1);
+}
+}  // namespace
+
+namespace {
+// Every pair of grains on a grid of cells one largest diameter wide: overlaps beyond kMaxOverlap of
+// the smaller diameter, or two grains at one centre, refuse the file.
+template <class Row>
+void check_overlaps(const std::vector<Row>& rows, const std::string& source) {
+  if (rows.empty()) return;
+  double r_max = 0.0;
+  for (const Row& r : rows) r_max = std::max(r_max, r.v[3]);
+  const double cell = 2.0 * r_max;
+  auto key = [&](double a) { return static_cast<std::int64_t>(std::floor(a / cell)); };
+  std::map<std::array<std::int64_t, 3>, std::vector<std::size_t>> grid;
+  for (std::size_t i = 0; i < rows.size(); ++i) grid[{key(rows[i].v[0]), key(rows[i].v[1]), key(rows[i].v[2])}].push_back(i);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const Row& a = rows[i];
+    const std::array<std::int64_t, 3> c{key(a.v[0]), key(a.v[1]), key(a.v[2])};
+    for (std::int64_t dx = -1; dx <= 1; ++dx)
+      for (std::int64_t dy = -1; dy <= 1; ++dy)
+        for (std::int64_t dz = -1; dz <= 1; ++dz) {
+          const auto it = grid.find({c[0] + dx, c[1] + dy, c[2] + dz});
+          if (it == grid.end()) continue;
+          for (std::size_t j : it->second) {
+            if (j <= i) continue;
+            const Row& b = rows[j];
+            const double d = std::sqrt((a.v[0] - b.v[0]) * (a.v[0] - b.v[0]) + (a.v[1] - b.v[1]) * (a.v[1] - b.v[1]) +
+                                       (a.v[2] - b.v[2]) * (a.v[2] - b.v[2]));
+            const double d_small = 2.0 * std::min(a.v[3], b.v[3]);
+            const int first = std::min(a.line, b.line), second = std::max(a.line, b.line);
+            const std::int64_t id1 = a.line < b.line ? a.id : b.id, id2 = a.line < b.line ? b.id : a.id;
+            if (d <= 1e-9 * d_small)
+              throw InputError(fmt::format("{}:{}: grains {} and {} (line {}) have one centre", source, second, id1, id2, first));
+            const double overlap = a.v[3] + b.v[3] - d;
+            if (overlap > kMaxOverlap * d_small)
+              throw InputError(fmt::format("{}:{}: grains {} and {} (line {}) overlap by {:.4g} mm, {:.3g} % of the smaller diameter; "
+                                           "at most {:g} % is a packed state",
+                                           source, second, id1, id2, first, overlap * 1e3, 100 * overlap / d_small,
+                                           100 * kMaxOverlap));
+          }
+        }
+  }
 }
 }  // namespace
 
@@ -110,7 +154,22 @@ Specimen parse_packed_specimen(const std::string& text, const std::string& sourc
       r.v[k] = std::strtod(cells[k + 1].c_str(), &end);
       if (cells[k + 1].empty() || *end != '\0' || !std::isfinite(r.v[k])) throw fail(lineno, "bad number '" + cells[k + 1] + "'");
     }
-    if (r.v[3] <= 0 || r.v[4] <= 0) throw fail(lineno, "radius and density must be > 0");
+    struct Range {
+      const char* column;
+      double lo, hi;
+      bool lo_open;
+    };
+    static constexpr Range ranges[] = {{"radius[m]", kMinGrainRadius, kMaxGrainRadius, false},
+                                       {"density[kg/m3]", kMinGrainDensity, kMaxGrainDensity, false},
+                                       {"young_mod[Pa]", kMinGrainModulus, kMaxGrainModulus, false},
+                                       {"pois_ratio[-]", kMinPoisson, kMaxPoisson, true}};
+    for (int k = 0; k < 4; ++k) {
+      const Range& g = ranges[k];
+      const double x = r.v[k + 3];
+      if ((g.lo_open ? x <= g.lo : x < g.lo) || x > g.hi)
+        throw fail(lineno, fmt::format("grain {}: {} must be in {}{:g}, {:g}], got {:g}", r.id, g.column, g.lo_open ? "(" : "[", g.lo,
+                                       g.hi, x));
+    }
     rows.push_back(r);
   }
   auto get = [&](const std::string& k) -> std::pair<std::string, int> {
@@ -173,6 +232,12 @@ Specimen parse_packed_specimen(const std::string& text, const std::string& sourc
     const Vec3 x{r.v[0], r.v[1], r.v[2]};
     if (std::hypot(x.x, x.y) > radius || x.z < bottom || x.z > top)
       throw fail(r.line, fmt::format("ball {} lies outside the vessel", r.id));
+    const double rad = r.v[3];
+    const double beyond = std::max({std::hypot(x.x, x.y) + rad - radius, bottom - (x.z - rad), x.z + rad - top});
+    if (beyond > kMaxOverlap * 2.0 * rad)
+      throw fail(r.line, fmt::format("grain {} reaches {:.4g} mm beyond a vessel wall, {:.3g} % of its diameter; at most {:g} % "
+                                     "is a packed state",
+                                     r.id, beyond * 1e3, 100 * beyond / (2.0 * rad), 100 * kMaxOverlap));
     BallInit b;
     b.id = r.id;
     b.position = x;
@@ -183,6 +248,7 @@ Specimen parse_packed_specimen(const std::string& text, const std::string& sourc
     b.groups = grain_bit;
     sim.balls.add(b);
   }
+  check_overlaps(rows, source);
   sim.sort_balls_spatially();
   install_table(sim, packing_table(sim, p.contact, p.walls));
   sim.update_forces();

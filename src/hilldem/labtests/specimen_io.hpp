@@ -16,7 +16,19 @@ namespace hilldem {
 void save_packed_specimen(const Specimen& s, const PackingSettings& p, const std::string& path);
 std::string packed_specimen_text(const Specimen& s, const PackingSettings& p);
 
-// Throws InputError naming the file, line and value on malformed input. The packing contact and wall
+// What a grain of a specimen file may be: outside these a file is refused (InputError naming the file,
+// the line, the column, the range and the value), as a scenario is. The ranges bound real grains
+// (radius 1 µm .. 1 m; density of pumice to osmium; E of soft rubber to diamond; ν of an isotropic
+// elastic solid), and a packed state: two grains overlap by at most kMaxOverlap of the smaller one's
+// diameter (a packing at P_m overlaps by ~1e-4 .. 1e-3 of it), no two share a centre, no grain
+// reaches beyond a wall by more than kMaxOverlap of its diameter.
+inline constexpr double kMinGrainRadius = 1e-6, kMaxGrainRadius = 1.0;       // [m]
+inline constexpr double kMinGrainDensity = 100, kMaxGrainDensity = 25'000;   // [kg/m³]
+inline constexpr double kMinGrainModulus = 1e5, kMaxGrainModulus = 1.2e12;   // E [Pa]
+inline constexpr double kMinPoisson = -1.0, kMaxPoisson = 0.5;               // ν [-], (−1, 0.5]
+inline constexpr double kMaxOverlap = 0.01;                                   // [-] of the smaller diameter
+
+// Throws InputError naming the file, line and value on malformed input or a grain out of range. The packing contact and wall
 // settings stored in the file are written to *p when p is not null.
 Specimen load_packed_specimen(const std::string& path, PackingSettings* p = nullptr);
 Specimen parse_packed_specimen(const std::string& text, const std::string& source, PackingSettings* p = nullptr);

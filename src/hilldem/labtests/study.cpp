@@ -7,11 +7,13 @@
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <limits>
 #include <exception>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <mutex>
+#include <numbers>
 #include <ostream>
 #include <streambuf>
 #include <thread>
@@ -38,7 +40,41 @@ std::string CaseSpec::name() const {
   if (low == "c5n") g = "C5n";
   else if (low == "c5b") g = "C5b";
   else g = fs::path(grading).stem().string();
-  return g + (model == GrainModel::Hill ? "_Hill" : "_Linear") + (wet ? "_wet" : "");
+  return g + (model == GrainModel::Hill ? "_Hill" : "_Linear") + (wet ? "_wet" : "") +
+         (confinement > 0 ? fmt::format("_{:g}kPa", confinement / 1e3) : std::string());
+}
+
+std::vector<CaseSpec> sweep_confinements(const std::vector<CaseSpec>& cases, const std::vector<double>& confinements) {
+  std::vector<CaseSpec> out;
+  for (double sc : confinements)
+    for (CaseSpec c : cases) {
+      c.confinement = sc;
+      out.push_back(c);
+    }
+  return out;
+}
+
+double confinement_of(const StudySettings& settings, const CaseSpec& c) {
+  return c.confinement > 0 ? c.confinement : settings.triaxial.confinement;
+}
+
+double expected_grains(const Grading& g, double d_mult, double R, double H, double n_c) {
+  double per_volume = 0.0;  // grains per unit solid volume
+  for (const GradingBin& b : g.bins) {
+    const double lo = b.d_lower * d_mult, hi = b.d_upper * d_mult;
+    // E[π d³/6] for d uniform in [lo, hi]: π (hi⁴ − lo⁴) / (24 (hi − lo)); π lo³/6 for a single size.
+    const double mean_v = hi > lo ? std::numbers::pi * (std::pow(hi, 4) - std::pow(lo, 4)) / (24.0 * (hi - lo))
+                                  : std::numbers::pi * lo * lo * lo / 6.0;
+    if (mean_v > 0) per_volume += b.fraction / mean_v;
+  }
+  return (1.0 - n_c) * std::numbers::pi * R * R * H * per_volume;
+}
+
+std::pair<double, double> vessel_for(const StudySettings& settings, const Grading& g) {
+  const GenesisSpec& v = settings.genesis;
+  const double n = expected_grains(g, v.d_mult, v.vessel_radius, v.vessel_height, v.packing.cloud_porosity);
+  const double f = settings.min_grains > 0 && n > 0 && n < settings.min_grains ? std::cbrt(settings.min_grains / n) : 1.0;
+  return {f * v.vessel_radius, f * v.vessel_height};
 }
 
 std::vector<CaseSpec> memo_cases() {
@@ -52,9 +88,15 @@ std::vector<CaseSpec> memo_cases() {
 void validate(const StudySettings& s, const std::vector<CaseSpec>& cases) {
   if (cases.empty()) throw InputError("no cases to run");
   validate(s.triaxial);
+  if (s.min_grains < 0 || s.min_grains > 1'000'000)
+    throw InputError(fmt::format("--min-grains must be in [0, 1000000], got {}", s.min_grains));
   for (const CaseSpec& c : cases) {
+    if (!(c.confinement >= 0) || !std::isfinite(c.confinement))
+      throw InputError(fmt::format("case {}: confinement must be 0 (the test's) or a finite number > 0 Pa, got {:g}", c.name(),
+                                   c.confinement));
     GenesisSpec g = s.genesis;
     g.grading = resolve_grading(c.grading);
+    std::tie(g.vessel_radius, g.vessel_height) = vessel_for(s, g.grading);
     validate(g);
     if (c.wet && c.model != GrainModel::Hill)
       throw InputError("--wet needs the hill material: the linear model has no liquid bridges");
@@ -96,20 +138,34 @@ std::string state_text(const char* label, const SpecimenState& s) {
                      s.bottom_stress / 1e3, s.top_stress / 1e3, s.radius * 1e3, s.height * 1e3, s.wet_contacts, s.ratio);
 }
 
+// A CSV cell of a fit: its slope or (se) its standard error [Pa]; empty when not fitted.
+std::string fit_cell(const LineFit& f, bool se) {
+  return f.valid ? fmt::format("{:.9g}", se ? f.slope_se : f.slope) : std::string();
+}
+
 std::string loops_csv(const std::vector<LoopResult>& loops) {
   std::string out =
-      "cycle,target_strain[-],eps_A[-],q_A[Pa],eps_B[-],q_B[Pa],q_C[Pa],closed,resilient_modulus_unload_secant[Pa],"
-      "reload_secant[Pa],loop_area[J/m3],damping_ratio[-]\n";
+      "cycle,target_strain[-],eps_A[-],q_A[Pa],eps_B[-],q_B[Pa],q_C[Pa],closed,resilient_modulus_fit[Pa],"
+      "resilient_modulus_fit_se[Pa],fit_points,unload_secant[Pa],reload_fit[Pa],reload_fit_se[Pa],reload_secant[Pa],"
+      "loop_area[J/m3],damping_ratio[-]\n";
   for (const LoopResult& l : loops)
-    out += fmt::format("{},{:.6g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{},{:.9g},{:.9g},{:.9g},{:.6g}\n", l.cycle, l.target_strain,
-                       l.eps_a, l.q_a, l.eps_b, l.q_b, l.q_c, l.closed ? 1 : 0, l.unload_secant, l.reload_secant, l.loop_area,
-                       l.damping_ratio);
+    out += fmt::format("{},{:.6g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{},{},{},{},{:.9g},{},{},{:.9g},{:.9g},{:.6g}\n", l.cycle,
+                       l.target_strain, l.eps_a, l.q_a, l.eps_b, l.q_b, l.q_c, l.closed ? 1 : 0, fit_cell(l.unload, false),
+                       fit_cell(l.unload, true), l.unload.points, l.unload_secant, fit_cell(l.reload, false), fit_cell(l.reload, true),
+                       l.reload_secant, l.loop_area, l.damping_ratio);
   return out;
 }
 
 // A CSV cell of the interior porosity: empty when it could not be measured.
 std::string interior_cell(const SpecimenState& s) {
   return s.interior_margin == SpecimenState::Margin::None ? std::string() : fmt::format("{:.6g}", s.interior_porosity);
+}
+
+// The packing's convergence: its porosity change per 1,000 steps at the end, or why there is none.
+std::string packing_change_text(const std::vector<PhaseReport>& phases) {
+  for (const PhaseReport& ph : phases)
+    if (ph.name == "packing" && ph.porosity_change >= 0) return fmt::format("{:.1e}", ph.porosity_change);
+  return "n/a (loaded)";
 }
 
 std::size_t max_loops(const std::vector<CaseResult>& cases) {
@@ -123,27 +179,32 @@ std::size_t max_loops(const std::vector<CaseResult>& cases) {
 std::string StudyResult::summary_csv() const {
   const std::size_t nl = max_loops(cases);
   std::string out =
-      "case,grading,material,wet,packing_model,grains,porosity_packed[-],interior_porosity_packed[-],interior_margin_packed[m],"
+      "case,grading,material,wet,packing_model,confinement[Pa],grains,porosity_packed[-],interior_porosity_packed[-],interior_margin_packed[m],"
       "porosity_test_start[-],interior_porosity_test_start[-],coordination_packed[-],coordination_test_start[-],"
-      "sigma_r_start[Pa],sigma_axial_start[Pa],peak_q[Pa],peak_eps_a[-]";
+      "sigma_r_start[Pa],sigma_axial_start[Pa],peak_q[Pa],peak_eps_a[-],peak_eps_r[-],peak_eps_v[-],packing_porosity_change_per_1000_steps[-]";
   for (std::size_t k = 1; k <= nl; ++k)
-    out += fmt::format(",eps_A_cycle{0}[-],Mr_unload_secant_cycle{0}[Pa],reload_secant_cycle{0}[Pa],loop_area_cycle{0}[J/m3],"
+    out += fmt::format(",eps_A_cycle{0}[-],Mr_fit_cycle{0}[Pa],Mr_fit_se_cycle{0}[Pa],Mr_unload_secant_cycle{0}[Pa],"
+                       "reload_fit_cycle{0}[Pa],reload_fit_se_cycle{0}[Pa],reload_secant_cycle{0}[Pa],loop_area_cycle{0}[J/m3],"
                        "damping_ratio_cycle{0}[-]",
                        k);
   out += ",worst_confinement_error[-],worst_platen_mismatch[-],test_steps,packing_seconds,seconds\n";
   for (const CaseResult& c : cases) {
-    out += fmt::format("{},{},{},{},{},{},{:.6g},{},{:.6g},{:.6g},{},{:.6g},{:.6g},{:.9g},{:.9g},{:.9g},{:.6g}", c.spec.name(),
-                       c.grading.name, to_string(c.spec.model), c.spec.wet ? 1 : 0, to_string(c.packed_with), c.initial.grains,
+    out += fmt::format("{},{},{},{},{},{:g},{},{:.6g},{},{:.6g},{:.6g},{},{:.6g},{:.6g},{:.9g},{:.9g},{:.9g},{:.6g}", c.spec.name(),
+                       c.grading.name, to_string(c.spec.model), c.spec.wet ? 1 : 0, to_string(c.packed_with), c.confinement, c.initial.grains,
                        c.packed.porosity, interior_cell(c.packed), c.packed.interior_margin_length, c.initial.porosity,
                        interior_cell(c.initial), c.packed.coordination, c.initial.coordination, c.initial.radial_stress,
                        0.5 * (c.initial.bottom_stress + c.initial.top_stress), c.test.peak_q, c.test.peak_strain);
+    const std::string dn = packing_change_text(c.phases);
+    out += fmt::format(",{:.6g},{:.6g},{}", c.test.peak_radial_strain, c.test.peak_volumetric_strain, dn.rfind("n/a", 0) == 0 ? "" : dn);
     for (std::size_t k = 0; k < nl; ++k) {
       if (k < c.test.loops.size()) {
         const LoopResult& l = c.test.loops[k];
-        out += fmt::format(",{:.6g},{:.9g},{},{:.9g},{}", l.eps_a, l.unload_secant, l.closed ? fmt::format("{:.9g}", l.reload_secant) : "",
-                           l.loop_area, l.closed ? fmt::format("{:.6g}", l.damping_ratio) : "");
+        out += fmt::format(",{:.6g},{},{},{:.9g},{},{},{},{:.9g},{}", l.eps_a, fit_cell(l.unload, false), fit_cell(l.unload, true),
+                           l.unload_secant, fit_cell(l.reload, false), fit_cell(l.reload, true),
+                           l.closed ? fmt::format("{:.9g}", l.reload_secant) : "", l.loop_area,
+                           l.closed ? fmt::format("{:.6g}", l.damping_ratio) : "");
       } else {
-        out += ",,,,,";
+        out += ",,,,,,,,,";
       }
     }
     out += fmt::format(",{:.6g},{:.6g},{},{:.1f},{:.1f}\n", c.test.worst_confinement_error, c.test.worst_platen_mismatch,
@@ -155,68 +216,92 @@ std::string StudyResult::summary_csv() const {
 std::string StudyResult::summary_markdown() const {
   const std::size_t nl = max_loops(cases);
   std::string head =
-      "| case | packed with | grains | porosity packed: vessel / interior | at test start: vessel / interior | Z packed | Z | "
-      "peak q [kPa] | at eps_a [%] |";
-  std::string rule = "|---|---|---:|---:|---:|---:|---:|---:|---:|";
+      "| case | packed with | grains | porosity packed: vessel / interior | packing dn per 1000 steps | at test start: vessel / interior | "
+      "Z packed | Z | peak q [kPa] | at eps_a [%] | eps_v at peak [%] |";
+  std::string rule = "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|";
   for (std::size_t k = 1; k <= nl; ++k) {
-    head += fmt::format(" M_r c{0} [MPa] | reload c{0} [MPa] | loop c{0} [J/m³] |", k);
-    rule += "---:|---:|---:|";
+    head += fmt::format(" M_r c{0} [MPa] | secant c{0} [MPa] | reload c{0} [MPa] | loop c{0} [J/m³] |", k);
+    rule += "---:|---:|---:|---:|";
   }
   head += " worst sigma_r error [%] | worst platen mismatch [%] | test steps | time [s] |";
   rule += "---:|---:|---:|---:|";
   std::string out = head + "\n" + rule + "\n";
   for (const CaseResult& c : cases) {
-    out += fmt::format("| {} | {} | {} | {:.4f} / {} | {:.4f} / {} | {:.2f} | {:.2f} | {:.1f} | {:.3f} |", c.spec.name(),
-                       to_string(c.packed_with), c.initial.grains, c.packed.porosity, interior_text(c.packed), c.initial.porosity,
-                       interior_text(c.initial), c.packed.coordination, c.initial.coordination, c.test.peak_q / 1e3,
-                       100 * c.test.peak_strain);
+    out += fmt::format("| {} | {} | {} | {:.4f} / {} | {} | {:.4f} / {} | {:.2f} | {:.2f} | {:.1f} | {:.3f} | {:.3f} |", c.spec.name(),
+                       to_string(c.packed_with), c.initial.grains, c.packed.porosity, interior_text(c.packed),
+                       packing_change_text(c.phases), c.initial.porosity, interior_text(c.initial), c.packed.coordination,
+                       c.initial.coordination, c.test.peak_q / 1e3, 100 * c.test.peak_strain, 100 * c.test.peak_volumetric_strain);
     for (std::size_t k = 0; k < nl; ++k) {
       if (k < c.test.loops.size()) {
         const LoopResult& l = c.test.loops[k];
-        out += fmt::format(" {:.1f} | {} | {:.3g} |", l.unload_secant / 1e6,
-                           l.closed ? fmt::format("{:.1f}", l.reload_secant / 1e6) : std::string("n/a"), l.loop_area);
+        out += fmt::format(" {} | {:.1f} | {} | {:.3g} |", fit_text(l.unload), l.unload_secant / 1e6, fit_text(l.reload), l.loop_area);
       } else {
-        out += " | | |";
+        out += " | | | |";
       }
     }
     out += fmt::format(" {:.2f} | {:.2f} | {} | {:.0f} |\n", 100 * c.test.worst_confinement_error, 100 * c.test.worst_platen_mismatch,
                        c.test.steps, c.seconds);
   }
-  out += "\nM_r: resilient modulus, unload secant (q_A − q_B)/(eps_A − eps_B); reload: reload secant (q_C − q_B)/(eps_A − eps_B);\n"
+  out += "\nM_r: resilient modulus, the slope of the least-squares line through the unload branch's points with q in the middle\n"
+         "80 % of q_B..q_A, +- its standard error (block jackknife: honest for the ringing's correlated residuals); secant: the\n"
+         "two-point unload "
+         "secant (q_A − q_B)/(eps_A − eps_B); reload: the same fit over the reload branch (q_B..q_C);\n"
          "loop: hysteresis, loop area ∮ q d(eps_a) = energy dissipated per unit volume. Z: touching grain-grain contacts per grain\n"
          "(Z packed: after packing; Z: at the test start).\n"
          "Packed with: the grain-grain contact model of the frictionless packing (mu = 0); finalization installs the material\n"
          "and restores its friction (mu = 0.4). Each material is packed with its own model unless --pack-linear.\n"
          "Porosity: vessel = 1 − V_grains/(π R² H); interior = in the coaxial cylinder one D_max in from every wall (D50 where\n"
          "the vessel is too small for that: marked; n/a where even that leaves less than D_max in radius or 2 D_max in height).\n"
-         "Time: finalization, wetting and test of the case (wall clock); packing is done once per grading and packing model.\n";
+         "Time: finalization, wetting and test of the case (wall clock); packing is done once per grading and packing model.\n"
+         "eps_v = eps_a + 2 eps_r (compression positive; negative: dilation), at the peak deviator.\n";
+  if (!criterion.empty())
+    out += "Packing, finalization and wetting converged when " + criterion +
+           "; packing dn: the packing's vessel-porosity change per 1,000 steps at its end.\n";
   const auto f = findings();
   if (!f.empty()) {
-    out += "\nFindings of the memo, checked:\n\n";
+    out += "\nFindings of the memo, checked (a comparison of M_r holds or fails only where the difference exceeds twice its\n"
+           "standard error; otherwise it is within noise):\n\n";
     for (const std::string& s : f) out += "* " + s + "\n";
   }
   return out;
 }
 
-std::vector<std::string> StudyResult::findings() const {
+namespace {
+// The memo's findings over cases of one confinement.
+std::vector<std::string> findings_of(const std::vector<CaseResult>& cases) {
   std::vector<std::string> out;
   auto find = [&](const std::string& grading, GrainModel m, bool wet) -> const CaseResult* {
     for (const CaseResult& c : cases)
       if (c.grading.name == grading && c.spec.model == m && c.spec.wet == wet) return &c;
     return nullptr;
   };
-  // Each claim is a set of comparisons; the verdict says how many of them hold.
+  // Each claim is a set of comparisons "a > b". A comparison of fitted moduli holds or fails only when
+  // the difference exceeds twice its standard error, sqrt(s_a² + s_b²); otherwise it is within noise.
+  // Loop areas and peak deviators carry no uncertainty here: their comparisons are taken as they are.
   struct Tally {
-    int yes = 0, n = 0;
-    void add(bool b) { yes += b ? 1 : 0, ++n; }
+    int yes = 0, no = 0, noise = 0, n = 0;
+    void add(bool b) { add(b ? 1.0 : -1.0, 0.0, 0.0, 0.0); }
+    void add(double a, double sa, double b, double sb) {
+      ++n;
+      const double d = a - b, s = std::sqrt(sa * sa + sb * sb);
+      if (!(std::abs(d) > 2.0 * s)) ++noise;
+      else if (d > 0) ++yes;
+      else ++no;
+    }
   };
   auto verdict = [](const Tally& t) {
+    const std::string noise = t.noise > 0 ? fmt::format("; {} within noise", t.noise) : std::string();
     if (t.yes == t.n) return fmt::format("HOLDS ({} of {} comparisons)", t.yes, t.n);
-    if (t.yes == 0) return fmt::format("DOES NOT HOLD (0 of {} comparisons)", t.n);
-    return fmt::format("HOLDS IN PART ({} of {} comparisons)", t.yes, t.n);
+    if (t.noise == t.n) return fmt::format("WITHIN NOISE ({} of {} comparisons within 2 standard errors)", t.noise, t.n);
+    if (t.yes == 0) return fmt::format("DOES NOT HOLD (0 of {} comparisons{})", t.n, noise);
+    return fmt::format("HOLDS IN PART ({} of {} comparisons{})", t.yes, t.n, noise);
   };
-  const std::size_t nl = max_loops(cases);
-
+  // A loop's M_r (the unload fit) and its standard error; an unfitted loop has no usable value.
+  auto mr = [](const LoopResult& l) { return l.unload.valid ? l.unload.slope : 0.0; };
+  auto mr_se = [](const LoopResult& l) { return l.unload.valid ? l.unload.slope_se : std::numeric_limits<double>::infinity(); };
+  auto mr_text = [](const LoopResult& l) {
+    return l.unload.valid ? fmt::format("{:.1f} +- {:.1f}", l.unload.slope / 1e6, l.unload.slope_se / 1e6) : std::string("n/a");
+  };
   // 1. Hysteresis loops larger for hill than for linear.
   {
     std::string detail;
@@ -237,7 +322,8 @@ std::vector<std::string> StudyResult::findings() const {
   }
   // 2-3. C5b stiffer and stronger than C5n, more so for hill.
   {
-    std::map<GrainModel, std::pair<std::vector<double>, double>> ratios;  // M_r ratios per cycle, peak ratio
+    // Per model: the M_r ratios per cycle with their standard errors, and the peak ratio.
+    std::map<GrainModel, std::pair<std::vector<std::pair<double, double>>, double>> ratios;
     std::string stiff, strong;
     Tally ok_stiff, ok_strong;
     bool any = false;
@@ -247,11 +333,15 @@ std::vector<std::string> StudyResult::findings() const {
       any = true;
       auto& r = ratios[m];
       for (std::size_t k = 0; k < std::min(b->test.loops.size(), n->test.loops.size()); ++k) {
-        const double x = b->test.loops[k].unload_secant, y = n->test.loops[k].unload_secant;
-        r.first.push_back(y > 0 ? x / y : 0.0);
-        stiff += fmt::format("{}{} cycle {}: M_r C5b {:.1f} vs C5n {:.1f} MPa (x{:.2f})", stiff.empty() ? "" : "; ", to_string(m), k + 1,
-                             x / 1e6, y / 1e6, r.first.back());
-        ok_stiff.add(x > y);
+        const LoopResult &lb = b->test.loops[k], &ln = n->test.loops[k];
+        const double x = mr(lb), y = mr(ln), sx = mr_se(lb), sy = mr_se(ln);
+        const double ratio = x > 0 && y > 0 ? x / y : 0.0;
+        // σ of a ratio: (x/y) sqrt((σ_x/x)² + (σ_y/y)²).
+        const double s_ratio = ratio > 0 ? ratio * std::hypot(sx / x, sy / y) : std::numeric_limits<double>::infinity();
+        r.first.emplace_back(ratio, s_ratio);
+        stiff += fmt::format("{}{} cycle {}: M_r C5b {} vs C5n {} MPa (x{:.2f})", stiff.empty() ? "" : "; ", to_string(m), k + 1,
+                             mr_text(lb), mr_text(ln), ratio);
+        ok_stiff.add(x, sx, y, sy);
       }
       r.second = n->test.peak_q > 0 ? b->test.peak_q / n->test.peak_q : 0.0;
       strong += fmt::format("{}{}: peak q C5b {:.1f} vs C5n {:.1f} kPa (x{:.2f})", strong.empty() ? "" : "; ", to_string(m),
@@ -268,8 +358,9 @@ std::vector<std::string> StudyResult::findings() const {
       Tally ok;
       ok.add(h.second > l.second);
       for (std::size_t k = 0; k < std::min(h.first.size(), l.first.size()); ++k) {
-        d += fmt::format("{}M_r ratio cycle {}: hill x{:.3f} vs linear x{:.3f}", d.empty() ? "" : "; ", k + 1, h.first[k], l.first[k]);
-        ok.add(h.first[k] > l.first[k]);
+        d += fmt::format("{}M_r ratio cycle {}: hill x{:.3f} +- {:.3f} vs linear x{:.3f} +- {:.3f}", d.empty() ? "" : "; ", k + 1,
+                         h.first[k].first, h.first[k].second, l.first[k].first, l.first[k].second);
+        ok.add(h.first[k].first, h.first[k].second, l.first[k].first, l.first[k].second);
       }
       d += fmt::format("; peak-q ratio: hill x{:.3f} vs linear x{:.3f}", h.second, l.second);
       out.push_back("the C5b/C5n difference is larger for hill: " + d + " -> " + verdict(ok));
@@ -282,17 +373,70 @@ std::vector<std::string> StudyResult::findings() const {
       std::string detail;
       Tally ok;
       for (std::size_t k = 0; k < std::min(w->test.loops.size(), d->test.loops.size()); ++k) {
-        const double a = w->test.loops[k].unload_secant, b = d->test.loops[k].unload_secant;
-        detail += fmt::format("{}cycle {}: wet {:.1f} vs dry {:.1f} MPa (x{:.2f})", detail.empty() ? "" : "; ", k + 1, a / 1e6, b / 1e6,
-                              b > 0 ? a / b : 0.0);
-        ok.add(a > b);
+        const LoopResult &lw = w->test.loops[k], &ld = d->test.loops[k];
+        const double a = mr(lw), b = mr(ld);
+        detail += fmt::format("{}cycle {}: M_r wet {} vs dry {} MPa (x{:.2f})", detail.empty() ? "" : "; ", k + 1, mr_text(lw),
+                              mr_text(ld), a > 0 && b > 0 ? a / b : 0.0);
+        ok.add(a, mr_se(lw), b, mr_se(ld));
       }
       out.push_back("wet C5b hill has a higher resilient modulus than dry: " + detail + " -> " + verdict(ok));
     }
   }
-  (void)nl;
   return out;
 }
+}  // namespace
+
+std::vector<std::string> StudyResult::findings() const {
+  std::vector<double> levels;  // the confinements, in case order
+  for (const CaseResult& c : cases)
+    if (std::find(levels.begin(), levels.end(), c.spec.confinement) == levels.end()) levels.push_back(c.spec.confinement);
+  std::vector<std::string> out;
+  for (double sc : levels) {
+    std::vector<CaseResult> group;
+    for (const CaseResult& c : cases)
+      if (c.spec.confinement == sc) group.push_back(c);
+    for (const std::string& f : findings_of(group))
+      out.push_back(levels.size() > 1 ? fmt::format("at sigma_c = {:g} kPa: {}", sc / 1e3, f) : f);
+  }
+  return out;
+}
+
+std::vector<std::string> impossible_state(const SpecimenState& st, double target) {
+  std::vector<std::string> out;
+  for (const auto& [name, v] : {std::pair{"sigma_r", st.radial_stress}, std::pair{"sigma_bottom", st.bottom_stress},
+                                std::pair{"sigma_top", st.top_stress}})
+    if (!std::isfinite(v) || std::abs(v - target) > kStateTolerance * target)
+      out.push_back(fmt::format("{} {:.6g} kPa, more than {:g} % from the target {:g} kPa", name, v / 1e3, 100 * kStateTolerance,
+                                target / 1e3));
+  if (!std::isfinite(st.porosity) || st.porosity <= 0.0 || st.porosity >= 1.0)
+    out.push_back(fmt::format("vessel porosity {:.6g} outside (0, 1)", st.porosity));
+  return out;
+}
+
+std::vector<std::string> impossible_results(const TriaxialResult& r) {
+  std::vector<std::string> out;
+  for (const LoopResult& l : r.loops) {
+    if (!(l.q_a > 0.0))
+      out.push_back(fmt::format("cycle {}: deviator at the reversal q_A = {:.6g} kPa under compression (must be > 0)", l.cycle,
+                                l.q_a / 1e3));
+    if (l.closed && !(l.loop_area >= 0.0))
+      out.push_back(fmt::format("cycle {}: loop area {:.6g} J/m^3 < 0 (a loop cannot return energy)", l.cycle, l.loop_area));
+    if (l.closed && !(l.damping_ratio >= 0.0))
+      out.push_back(fmt::format("cycle {}: damping ratio {:.6g} < 0", l.cycle, l.damping_ratio));
+    if (l.unload.valid && !(l.unload.slope > 0.0))
+      out.push_back(fmt::format("cycle {}: resilient modulus {:.6g} MPa (must be > 0)", l.cycle, l.unload.slope / 1e6));
+  }
+  if (!(r.peak_q > 0.0)) out.push_back(fmt::format("peak deviator {:.6g} kPa under compression (must be > 0)", r.peak_q / 1e3));
+  return out;
+}
+
+namespace {
+std::string joined(const std::vector<std::string>& v) {
+  std::string out;
+  for (const std::string& s : v) out += (out.empty() ? "" : "; ") + s;
+  return out;
+}
+}  // namespace
 
 GrainModel packing_model(const StudySettings& settings, const CaseSpec& c) {
   return settings.pack_linear ? GrainModel::Linear : c.model;
@@ -321,6 +465,7 @@ PackedResult make_packed(const StudySettings& settings, const std::string& gradi
   } else {
     GenesisSpec g = settings.genesis;
     g.grading = grading;
+    std::tie(g.vessel_radius, g.vessel_height) = vessel_for(settings, grading);
     g.grain = settings.material;
     g.packing = ps;
     p.specimen = pack_specimen(g, log);
@@ -332,13 +477,15 @@ PackedResult make_packed(const StudySettings& settings, const std::string& gradi
   }
   p.report = grading_report(grading, p.specimen.d_mult, p.specimen.diameters());
   p.state = measure(p.specimen);
+  if (const auto bad = impossible_state(p.state, p.specimen.pressure); !bad.empty())
+    throw RunError(fmt::format("{}: the packed specimen is physically impossible: {}", p.file.empty() ? stem : p.file, joined(bad)));
   p.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (log) *log << p.report.text() << state_text("packed", p.state);
   if (save && settings.specimen_file.empty()) {
     write_file(dir / (stem + "_gsd.csv"), p.report.csv());
+    const auto [vr, vh] = vessel_for(settings, grading);
     std::string gen = fmt::format("grading {}, seed {}, vessel {:g} mm x {:g} mm, P_m {:g} kPa, packed with {} contacts, friction {:g}\n",
-                                  grading.name, p.specimen.seed, 2e3 * settings.genesis.vessel_radius,
-                                  1e3 * settings.genesis.vessel_height, settings.genesis.packing.equilibrium.pressure / 1e3,
+                                  grading.name, p.specimen.seed, 2e3 * vr, 1e3 * vh, settings.genesis.packing.equilibrium.pressure / 1e3,
                                   to_string(model), ps.contact.fric);
     for (const PhaseReport& ph : p.specimen.phases) gen += ph.line() + "\n";
     gen += state_text("packed", p.state) + p.report.text();
@@ -349,15 +496,15 @@ PackedResult make_packed(const StudySettings& settings, const std::string& gradi
 
 std::string packing_table(const std::vector<PackedResult>& packed) {
   std::string out = "| grading | packed with | seed | grains | porosity (vessel) | porosity (interior) | Z | sigma_r [kPa] | "
-                    "sigma_bottom [kPa] | sigma_top [kPa] | packing steps | time [s] |\n"
-                    "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+                    "sigma_bottom [kPa] | sigma_top [kPa] | packing steps | dn per 1000 steps | time [s] |\n"
+                    "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const PackedResult& p : packed) {
     std::int64_t steps = 0;
     for (const PhaseReport& ph : p.specimen.phases) steps += ph.steps;
-    out += fmt::format("| {} | {} | {} | {} | {:.4f} | {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {} | {:.0f} |\n", p.report.name,
+    out += fmt::format("| {} | {} | {} | {} | {:.4f} | {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {} | {} | {:.0f} |\n", p.report.name,
                        to_string(p.specimen.packed_with), p.specimen.seed, p.state.grains, p.state.porosity, interior_text(p.state),
-                       p.state.coordination,
-                       p.state.radial_stress / 1e3, p.state.bottom_stress / 1e3, p.state.top_stress / 1e3, steps, p.seconds);
+                       p.state.coordination, p.state.radial_stress / 1e3, p.state.bottom_stress / 1e3, p.state.top_stress / 1e3, steps,
+                       packing_change_text(p.specimen.phases), p.seconds);
   }
   return out;
 }
@@ -558,6 +705,7 @@ StudyResult run_study(const StudySettings& settings, const std::vector<CaseSpec>
   std::vector<std::optional<CaseResult>> done(cases.size());
   std::mutex done_mutex;
   StudyResult study;
+  study.criterion = criterion_text(settings.genesis.packing.equilibrium);
   std::vector<std::string> names;
   for (const CaseSpec& c : cases) names.push_back(c.name());
   const int jobs = resolved_jobs(settings.jobs, cases.size());
@@ -590,14 +738,20 @@ StudyResult run_study(const StudySettings& settings, const std::vector<CaseSpec>
     EquilibriumSettings e = settings.finalize;
     finalize(s, m, settings.test_walls, e, clog);
     if (c.wet) make_specimen_wet(s, settings.suction, settings.moisture_gap, e, clog);
-    if (settings.triaxial.confinement != e.pressure) {  // isotropic at σ_c before the test
+    TriaxialSettings ts = settings.triaxial;
+    ts.confinement = r.confinement = confinement_of(settings, c);
+    if (ts.confinement != e.pressure) {  // isotropic at σ_c before the test
       EquilibriumSettings ce = e;
-      ce.pressure = settings.triaxial.confinement;
+      ce.pressure = ts.confinement;
       servo_equilibrium(s, ce, "confine " + s.material, clog);
     }
     r.initial = measure(s);
     r.phases = s.phases;
-    r.test = run_triaxial(s, settings.triaxial, clog);
+    if (const auto bad = impossible_state(r.initial, ts.confinement); !bad.empty())
+      throw RunError(fmt::format("case {}: the state at the test start is physically impossible: {}", c.name(), joined(bad)));
+    r.test = run_triaxial(s, ts, clog);
+    if (const auto bad = impossible_results(r.test); !bad.empty())
+      throw RunError(fmt::format("case {}: physically impossible results (no summary written): {}", c.name(), joined(bad)));
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - tc).count();
     const fs::path dir = out / c.name();
     r.dir = dir.string();
@@ -615,6 +769,7 @@ StudyResult run_study(const StudySettings& settings, const std::vector<CaseSpec>
     const std::lock_guard<std::mutex> lock(done_mutex);
     done[i] = std::move(r);
     StudyResult so_far;
+    so_far.criterion = study.criterion;
     for (const auto& d : done)
       if (d) so_far.cases.push_back(*d);
     write_file(out / "summary.csv", so_far.summary_csv());

@@ -18,14 +18,24 @@ struct CaseSpec {
   std::string grading = "C5b";  // "C5n", "C5b" or a grading CSV file
   GrainModel model = GrainModel::Hill;
   bool wet = false;
-  std::string name() const;  // "C5b_Hill", "C5b_Hill_wet", "<file stem>_Linear"
+  double confinement = 0.0;     // σ_c of this case [Pa]; 0: StudySettings::triaxial.confinement
+  // "C5b_Hill", "C5b_Hill_wet", "<file stem>_Linear"; a case of a confinement sweep ends in its σ_c,
+  // "C5b_Hill_100kPa".
+  std::string name() const;
 };
+
+// Each case once per confinement [Pa] (a sweep; cases in confinement order, each case's order kept).
+std::vector<CaseSpec> sweep_confinements(const std::vector<CaseSpec>& cases, const std::vector<double>& confinements);
 
 // The memo's five cases: C5n/C5b × linear/hill, plus C5b hill wet.
 std::vector<CaseSpec> memo_cases();
 
 struct StudySettings {
   GenesisSpec genesis;                  // vessel, packing; its grading is replaced by each case's
+  // A grading whose expected grain count in genesis's vessel (at the cloud porosity) is below this
+  // gets the same vessel shape scaled up until it holds that many (never scaled down); 0: every
+  // grading in genesis's vessel. vessel_for says which vessel a grading gets.
+  int min_grains = 0;
   Class5Material material;              // Table 7; `model` is replaced by each case's
   WallContact test_walls;               // grain-wall contacts after finalization
   EquilibriumSettings finalize;         // servo equilibrium after finalization and wetting (at P_m)
@@ -56,6 +66,7 @@ void validate(const StudySettings& s, const std::vector<CaseSpec>& cases);
 
 struct CaseResult {
   CaseSpec spec;
+  double confinement = 0.0;             // σ_c of its test [Pa]
   GradingReport grading;
   GrainModel packed_with = GrainModel::Linear;  // grain-grain model of the packing it started from
   SpecimenState packed;                 // after packing (frictionless)
@@ -70,12 +81,23 @@ struct CaseResult {
 
 struct StudyResult {
   std::vector<CaseResult> cases;
+  std::string criterion;                // the servo equilibria's convergence criterion in words (criterion_text)
   double seconds = 0.0;                 // wall clock [s]
   double cpu_seconds = 0.0;             // process CPU time, all threads [s]
   std::string summary_csv() const;
   std::string summary_markdown() const;  // the table and the findings
   std::vector<std::string> findings() const;  // the memo's qualitative claims, each with numbers and a verdict
 };
+
+// Physically impossible states and results, each with its reason (empty: none found). A state is
+// impossible when a wall stress lies more than kStateTolerance × target from the target it was brought
+// to (the servos stop within ε_P = 1 %); results are impossible when a loop reverses at q_A ≤ 0 or
+// dissipates negative energy (loop area or damping ratio below 0), a fitted M_r is not positive, or
+// the peak deviator under compression is not positive. run_study and make_packed throw RunError
+// (exit status 1) with these reasons instead of writing a summary.
+inline constexpr double kStateTolerance = 0.25;  // [-]
+std::vector<std::string> impossible_state(const SpecimenState& st, double target);
+std::vector<std::string> impossible_results(const TriaxialResult& r);
 
 // Runs the cases (settings.jobs at once), writing into settings.output_dir as each one ends; progress
 // to log (may be null). If a case fails, no new case starts and the error of the first failing case
@@ -95,6 +117,14 @@ struct PackedResult {
 };
 PackedResult make_packed(const StudySettings& settings, const std::string& grading, GrainModel model, bool save,
                          std::ostream* log);
+// The vessel [m] (radius, height) a grading is packed in: genesis's, scaled up for min_grains.
+std::pair<double, double> vessel_for(const StudySettings& settings, const Grading& g);
+// Expected grain count of a grading in a vessel of radius R and height H [m] at cloud porosity n_c:
+// (1 − n_c) π R² H Σ φ_j / E[V_j], E[V_j] the mean volume of a grain of bin j (diameter uniform).
+double expected_grains(const Grading& g, double d_mult, double R, double H, double n_c);
+// The σ_c of a case [Pa].
+double confinement_of(const StudySettings& settings, const CaseSpec& c);
+
 // The packing model of a case: its material's, or linear with settings.pack_linear.
 GrainModel packing_model(const StudySettings& settings, const CaseSpec& c);
 // make_packed for each distinct (grading, packing model) of the cases (by resolved name, in case

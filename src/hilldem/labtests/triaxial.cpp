@@ -58,9 +58,20 @@ void validate(const TriaxialSettings& t) {
 // ---------------------------------------------------------------------------------------------------
 // Loops
 
+LineFit fit_branch(const std::vector<double>& strain, const std::vector<double>& q, double lo, double hi) {
+  std::vector<double> x, y;
+  for (std::size_t i = 0; i < std::min(strain.size(), q.size()); ++i)
+    if (q[i] >= lo && q[i] <= hi) x.push_back(strain[i]), y.push_back(q[i]);
+  return fit_line(x, y);
+}
+
 void LoopTracker::close_current() {
   LoopResult& l = cur_;
   const double de = l.eps_a - l.eps_b, dq = l.q_a - l.q_b;
+  const double trim = kFitTrim * dq;
+  l.unload = fit_branch(unload_e_, unload_q_, l.q_b + trim, l.q_a - trim);
+  const double q_end = l.closed ? l.q_c : (reload_q_.empty() ? l.q_b : *std::max_element(reload_q_.begin(), reload_q_.end()));
+  l.reload = fit_branch(reload_e_, reload_q_, l.q_b + trim, q_end - trim);
   if (de > 0.0) {
     l.unload_secant = dq / de;
     if (l.closed) l.reload_secant = (l.q_c - l.q_b) / de;
@@ -79,6 +90,8 @@ void LoopTracker::add(TriaxialPhase phase, int cycle, double strain, double q) {
     cur_.eps_a = have_prev_ ? prev_strain_ : strain;
     cur_.q_a = have_prev_ ? prev_q_ : q;
     cur_.eps_b = cur_.eps_a, cur_.q_b = cur_.q_a;
+    unload_e_.assign(1, cur_.eps_a), unload_q_.assign(1, cur_.q_a);
+    reload_e_.clear(), reload_q_.clear();
     open_ = true;
   }
   if (open_) {
@@ -86,16 +99,20 @@ void LoopTracker::add(TriaxialPhase phase, int cycle, double strain, double q) {
     if (phase == TriaxialPhase::Unload && same_loop) {
       if (have_prev_) cur_.loop_area += 0.5 * (q + prev_q_) * (strain - prev_strain_);
       cur_.eps_b = strain, cur_.q_b = q;
+      unload_e_.push_back(strain), unload_q_.push_back(q);
     } else if (phase == TriaxialPhase::Reload && same_loop) {
       if (strain >= cur_.eps_a) {  // back at ε_A: C by linear interpolation, the loop closes
         const double span = strain - prev_strain_;
         const double t = span > 0.0 ? (cur_.eps_a - prev_strain_) / span : 1.0;
         cur_.q_c = prev_q_ + t * (q - prev_q_);
         cur_.loop_area += 0.5 * (prev_q_ + cur_.q_c) * (cur_.eps_a - prev_strain_);
+        reload_e_.push_back(cur_.eps_a), reload_q_.push_back(cur_.q_c);
         cur_.closed = true;
         close_current();
       } else {
         cur_.loop_area += 0.5 * (q + prev_q_) * (strain - prev_strain_);
+        if (reload_e_.empty()) reload_e_.push_back(cur_.eps_b), reload_q_.push_back(cur_.q_b);
+        reload_e_.push_back(strain), reload_q_.push_back(q);
       }
     } else {
       close_current();  // left the loop without closing it
@@ -214,7 +231,8 @@ TriaxialResult run_triaxial(Specimen& s, const TriaxialSettings& t, std::ostream
     const double conf_err = std::abs(r.sigma_r - t.confinement) / t.confinement;
     if (conf_err > res.worst_confinement_error) res.worst_confinement_error = conf_err, res.worst_confinement_strain = r.eps_a;
     if (r.platen_mismatch > res.worst_platen_mismatch) res.worst_platen_mismatch = r.platen_mismatch, res.worst_mismatch_strain = r.eps_a;
-    if (r.q > res.peak_q) res.peak_q = r.q, res.peak_strain = r.eps_a;
+    if (r.q > res.peak_q)
+      res.peak_q = r.q, res.peak_strain = r.eps_a, res.peak_radial_strain = r.eps_r, res.peak_volumetric_strain = r.eps_v;
     tracker.add(phase, cycle, r.eps_a, r.q);
     const double rec = phase == TriaxialPhase::Final ? final_rec : cycle_rec;
     if (force_record || std::abs(r.eps_a - last_rec_eps) >= rec) record(r);
@@ -262,9 +280,11 @@ TriaxialResult run_triaxial(Specimen& s, const TriaxialSettings& t, std::ostream
   res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (log) {
     *log << res.loops_text();
-    *log << fmt::format("triaxial: {} steps, {:.1f} s; peak q {:.2f} kPa at eps_a {:.3f} %; worst confinement error {:.3f} % "
+    *log << fmt::format("triaxial: {} steps, {:.1f} s; peak q {:.2f} kPa at eps_a {:.3f} % (eps_r {:.3f} %, eps_v {:.3f} %); "
+                        "worst confinement error {:.3f} % "
                         "(at {:.4f} %); worst platen mismatch {:.2f} % (at {:.4f} %)\n",
-                        res.steps, res.seconds, res.peak_q / 1e3, 100 * res.peak_strain, 100 * res.worst_confinement_error,
+                        res.steps, res.seconds, res.peak_q / 1e3, 100 * res.peak_strain, 100 * res.peak_radial_strain,
+                        100 * res.peak_volumetric_strain, 100 * res.worst_confinement_error,
                         100 * res.worst_confinement_strain, 100 * res.worst_platen_mismatch, 100 * res.worst_mismatch_strain);
   }
   return res;
@@ -281,12 +301,17 @@ std::string TriaxialResult::history_csv() const {
   return out;
 }
 
+std::string fit_text(const LineFit& f) {
+  if (!f.valid) return fmt::format("n/a ({} points in the fitted part)", f.points);
+  return fmt::format("{:.1f} +- {:.1f}", f.slope / 1e6, f.slope_se / 1e6);
+}
+
 std::string TriaxialResult::loops_text() const {
   std::string out;
   for (const LoopResult& l : loops)
-    out += fmt::format("  cycle {} (reversal at {:.4f} %): resilient modulus M_r (unload secant) {:.1f} MPa; reload secant {} MPa; "
-                       "loop area {:.4g} J/m^3; damping ratio {}\n",
-                       l.cycle, 100 * l.eps_a, l.unload_secant / 1e6,
+    out += fmt::format("  cycle {} (reversal at {:.4f} %): resilient modulus M_r (unload fit) {} MPa, unload secant {:.1f} MPa; "
+                       "reload fit {} MPa, reload secant {} MPa; loop area {:.4g} J/m^3; damping ratio {}\n",
+                       l.cycle, 100 * l.eps_a, fit_text(l.unload), l.unload_secant / 1e6, fit_text(l.reload),
                        l.closed ? fmt::format("{:.1f}", l.reload_secant / 1e6) : std::string("n/a (loop not closed)"),
                        l.loop_area, l.closed ? fmt::format("{:.4f}", l.damping_ratio) : std::string("n/a"));
   return out;

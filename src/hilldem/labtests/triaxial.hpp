@@ -2,7 +2,8 @@
 // wall holds the confinement σ_c through the radial servo; the platens move toward each other, each
 // at ½ ε̇ H₀ (strain control), with load-unload cycles at given axial strains and a final monotonic
 // load. Records stresses, strains, porosity and coordination; computes, per cycle, the resilient
-// modulus (unload secant), the reload secant and the loop hysteresis.
+// modulus (a least-squares fit over the middle of the unload branch, with its standard error; the
+// two-point unload secant beside it), the reload fit and secant, and the loop hysteresis.
 #pragma once
 
 #include <cstdint>
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include "hilldem/labtests/genesis.hpp"
+#include "hilldem/labtests/line_fit.hpp"
 
 namespace hilldem {
 
@@ -37,6 +39,11 @@ void validate(const TriaxialSettings& t);
 enum class TriaxialPhase : std::uint8_t { Load, Unload, Reload, Final };
 const char* to_string(TriaxialPhase p);
 
+// The part of a branch the moduli are fitted over: the points whose q lies in the middle of the
+// branch's deviator range, kFitTrim × (q_A − q_B) away from either end (unload: q_B .. q_A; reload:
+// q_B .. q_C). That leaves out the ringing right after each reversal and the turn at the branch's end.
+inline constexpr double kFitTrim = 0.1;  // [-]
+
 // One load-unload-reload loop: A = reversal (start of unloading), B = end of unloading, C = the reload
 // path back at ε_A.
 struct LoopResult {
@@ -46,7 +53,12 @@ struct LoopResult {
   double eps_b = 0.0, q_b = 0.0;      // B
   double q_c = 0.0;                   // C: q on reloading at ε_A [Pa]
   bool closed = false;                // the reload reached ε_A
-  double unload_secant = 0.0;         // M_r = (q_A − q_B)/(ε_A − ε_B) [Pa]: the resilient modulus
+  // M_r, the resilient modulus: slope dq/dε_a of the least-squares line through the unload points in
+  // the fitted part (kFitTrim), with its standard error (line_fit.hpp) [Pa]. unload.valid is false
+  // when that part has fewer than 3 points.
+  LineFit unload;
+  LineFit reload;                     // the same over the reload branch, up to ε_A [Pa]
+  double unload_secant = 0.0;         // (q_A − q_B)/(ε_A − ε_B) [Pa]: the two-point secant
   double reload_secant = 0.0;         // (q_C − q_B)/(ε_A − ε_B) [Pa]
   double loop_area = 0.0;             // ∮ q dε_a over A→B→C [J/m³ = Pa]: energy dissipated per unit volume
   double damping_ratio = 0.0;         // loop_area / (4π W_s), W_s = (q_A − q_B)(ε_A − ε_B)/8 [-]
@@ -67,7 +79,11 @@ class LoopTracker {
   bool have_prev_ = false;
   TriaxialPhase prev_phase_ = TriaxialPhase::Load;
   double prev_strain_ = 0.0, prev_q_ = 0.0;
+  std::vector<double> unload_e_, unload_q_, reload_e_, reload_q_;  // the current loop's branches
 };
+
+// The fit over the part of a branch (ε, q in path order) whose q lies in [lo, hi].
+LineFit fit_branch(const std::vector<double>& strain, const std::vector<double>& q, double lo, double hi);
 
 struct TriaxialRow {
   std::int64_t step = 0;
@@ -86,6 +102,7 @@ struct TriaxialResult {
   std::vector<LoopResult> loops;
   double height0 = 0.0, radius0 = 0.0;            // [m] at the start
   double peak_q = 0.0, peak_strain = 0.0;         // [Pa], [-]
+  double peak_radial_strain = 0.0, peak_volumetric_strain = 0.0;  // ε_r, ε_v at the peak [-] (compression positive)
   double worst_confinement_error = 0.0;           // max |σ_r − σ_c| / σ_c over every cycle [-]
   double worst_confinement_strain = 0.0;          // ε_a where it happened
   double worst_platen_mismatch = 0.0;             // max |σ_top − σ_bottom| / σ_a over every cycle [-]
@@ -95,6 +112,10 @@ struct TriaxialResult {
   std::string history_csv() const;
   std::string loops_text() const;                 // one labelled line per loop
 };
+
+// A fitted modulus as printed: "243.1 +- 2.3" [MPa] (slope +- standard error), or "n/a (2 points in
+// the fitted part)".
+std::string fit_text(const LineFit& f);
 
 TriaxialResult run_triaxial(Specimen& s, const TriaxialSettings& t, std::ostream* log);
 
