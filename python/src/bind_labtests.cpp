@@ -95,6 +95,7 @@ py::dict phase_dict(const PhaseReport& p) {
   PUT(d, p, name);
   PUT(d, p, steps);
   PUT(d, p, seconds);
+  PUT(d, p, porosity_change);
   d["state"] = state_dict(p.state);
   d["line"] = p.line();
   return d;
@@ -133,8 +134,22 @@ py::dict grading_report_dict(const GradingReport& g) {
   return d;
 }
 
+py::dict line_fit_dict(const LineFit& f) {
+  py::dict d;
+  PUT(d, f, slope);
+  PUT(d, f, intercept);
+  PUT(d, f, slope_se);
+  PUT(d, f, ols_se);
+  PUT(d, f, points);
+  PUT(d, f, blocks);
+  PUT(d, f, valid);
+  return d;
+}
+
 py::dict loop_dict(const LoopResult& l) {
   py::dict d;
+  d["unload"] = line_fit_dict(l.unload);  // M_r: the fit's slope [Pa] and its standard error
+  d["reload"] = line_fit_dict(l.reload);
   PUT(d, l, cycle);
   PUT(d, l, target_strain);
   PUT(d, l, eps_a);
@@ -178,6 +193,8 @@ py::dict triaxial_dict(const TriaxialResult& t) {
   PUT(d, t, radius0);
   PUT(d, t, peak_q);
   PUT(d, t, peak_strain);
+  PUT(d, t, peak_radial_strain);
+  PUT(d, t, peak_volumetric_strain);
   PUT(d, t, worst_confinement_error);
   PUT(d, t, worst_confinement_strain);
   PUT(d, t, worst_platen_mismatch);
@@ -195,6 +212,7 @@ py::dict case_dict(const CaseResult& c) {
   PUT(d, c, spec);
   d["grading"] = grading_report_dict(c.grading);
   PUT(d, c, packed_with);
+  PUT(d, c, confinement);
   d["packed"] = state_dict(c.packed);
   d["initial"] = state_dict(c.initial);
   d["phases"] = phase_list(c.phases);
@@ -213,6 +231,7 @@ py::dict study_dict(const StudyResult& s) {
   d["cases"] = cases;
   PUT(d, s, seconds);
   PUT(d, s, cpu_seconds);
+  PUT(d, s, criterion);
   d["summary_csv"] = s.summary_csv();
   d["summary_markdown"] = s.summary_markdown();
   d["findings"] = s.findings();
@@ -342,6 +361,9 @@ rows. InputError naming the file, line and value on bad input.)");
       .def_readwrite("servo_gain", &EquilibriumSettings::servo_gain, "Servo gain alpha_s [-].")
       .def_readwrite("wall_speed_limit", &EquilibriumSettings::wall_speed_limit, "Wall speed cap [m/s].")
       .def_readwrite("check_every", &EquilibriumSettings::check_every, "Cycles between convergence checks [-].")
+      .def_readwrite("porosity_change", &EquilibriumSettings::porosity_change,
+                     "Converged when the vessel porosity changes by at most this per 1,000 steps [-].")
+      .def_readwrite("porosity_window", &EquilibriumSettings::porosity_window, "Steps that change is taken over [-].")
       .def_readwrite("max_steps", &EquilibriumSettings::max_steps, "RunError after this many cycles [-].");
   py::class_<PackingSettings>(lab, "PackingSettings", "The grain cloud and its frictionless packing (lab-tests.md §3).")
       .def(py::init<>(), "The header's defaults.")
@@ -386,6 +408,7 @@ rows. InputError naming the file, line and value on bad input.)");
       .def_readwrite("grading", &CaseSpec::grading, "C5n, C5b or a grading CSV file.")
       .def_readwrite("model", &CaseSpec::model, "GrainModel.")
       .def_readwrite("wet", &CaseSpec::wet, "make_wet at the end of genesis (hill only).")
+      .def_readwrite("confinement", &CaseSpec::confinement, "Confinement of its test [Pa]; 0: the study's.")
       .def_property_readonly("name", &CaseSpec::name, "The case's name, e.g. C5b_Hill_wet.")
       .def("__repr__", [](const CaseSpec& c) { return "CaseSpec('" + c.name() + "')"; }, "Its name.");
   py::class_<StudySettings>(lab, "StudySettings", R"(Settings of study(): genesis, material, finalization, wetting, the
@@ -400,6 +423,8 @@ default is half that: genesis.vessel_radius = 0.0425, vessel_height = 0.120).)")
       .def_readwrite("moisture_gap", &StudySettings::moisture_gap, "Moisture gap g_m of make_wet [m].")
       .def_readwrite("triaxial", &StudySettings::triaxial, "TriaxialSettings.")
       .def_readwrite("pack_linear", &StudySettings::pack_linear, "Pack every material with linear contacts [bool].")
+      .def_readwrite("min_grains", &StudySettings::min_grains,
+                     "Scale each grading's vessel up (never down) until it holds this many grains; 0: off [-].")
       .def_readwrite("output_dir", &StudySettings::output_dir, "Folder the study writes into.")
       .def_readwrite("specimen_file", &StudySettings::specimen_file, "Start from this packed specimen ('' : pack).")
       .def_readwrite("save_specimens", &StudySettings::save_specimens, "Write the packed specimens [bool].")

@@ -65,7 +65,9 @@ def test_the_study_from_python_is_the_clis(cli_case, source_dir, tmp_path):
     assert list(h["phase"]) == [r["phase"] for r in rows]
     (loop,) = test["loops"]
     (cli_loop,) = read_csv(cli_case / "loops.csv")
-    assert loop["unload_secant"] == pytest.approx(float(cli_loop["resilient_modulus_unload_secant[Pa]"]), rel=1e-8)
+    assert loop["unload_secant"] == pytest.approx(float(cli_loop["unload_secant[Pa]"]), rel=1e-8)
+    assert loop["unload"]["slope"] == pytest.approx(float(cli_loop["resilient_modulus_fit[Pa]"]), rel=1e-8)
+    assert loop["unload"]["slope_se"] == pytest.approx(float(cli_loop["resilient_modulus_fit_se[Pa]"]), rel=1e-8)
     assert test["peak_q"] == pytest.approx(max(float(r["q[Pa]"]) for r in rows), rel=1e-8)
     assert case["initial"]["wet_contacts"] > 0 and case["grading"]["count"] == case["initial"]["grains"]
 
