@@ -40,7 +40,7 @@ struct WallContact {
 // model at the packing friction μ_CA = 0 (Table 7) — hill contacts between hill grains (Hertz from
 // the grains' E and ν, damping γ_h, dry), linear contacts (E*, κ*) between linear grains.
 // Finalization then installs the material's table, which restores the friction μ. The shared
-// linear packing of earlier versions (both materials packed with linear contacts, one packed
+// linear packing (both materials packed with linear contacts, one packed
 // specimen per grading) is `model = GrainModel::Linear` for either material: a deviation from the
 // memo, kept as an option (StudySettings::pack_linear, `hilldem triaxial --pack-linear`).
 struct PackingContact {

@@ -45,7 +45,7 @@ struct StudySettings {
   // finalized (and wetted) specimen is first brought to σ_c on every wall by the same servo
   // equilibrium ("confine" phase), so that each test starts isotropic at σ_c.
   TriaxialSettings triaxial;
-  // The shared linear packing of earlier versions: every material packed with the frictionless linear
+  // The shared linear packing: every material packed with the frictionless linear
   // packing contacts (genesis.packing.contact's E*, κ*), one packed specimen per grading, the hill
   // model installed only at finalization. A deviation from the memo (lab-tests.md §3.2), kept as an
   // option (`--pack-linear`). Default: each material packed with its own model.
