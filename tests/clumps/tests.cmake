@@ -2,6 +2,7 @@
 # law of motion. Included from tests/CMakeLists.txt.
 add_executable(hilldem_clump_tests
   clumps/test_quaternion.cpp
+  clumps/test_clump_template.cpp
 )
 target_link_libraries(hilldem_clump_tests PRIVATE hilldem::core GTest::gtest_main)
 target_compile_options(hilldem_clump_tests PRIVATE -Wall -Wextra -Wpedantic)
