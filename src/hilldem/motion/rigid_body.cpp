@@ -36,27 +36,6 @@ void turn_about(Quat& q, Vec3& lb, const Vec3& inertia, int k, double tau) {
 
 }  // namespace
 
-std::size_t ClumpState::add(const Vec3& x, const Vec3& v, const Quat& q, const Vec3& omega, double m,
-                            const Vec3& inertia, FixityMask fix) {
-  const Quat qn = normalized(q);
-  position.push_back(x);
-  velocity.push_back(v);
-  orientation.push_back(qn);
-  spin.push_back(omega);
-  body_momentum.push_back(times(inertia, rotate(conjugate(qn), omega)));
-  mass.push_back(m);
-  principal_inertia.push_back(inertia);
-  fixity.push_back(fix);
-  return mass.size() - 1;
-}
-
-Vec3 angular_momentum(const ClumpState& s, std::size_t i) { return rotate(s.orientation[i], s.body_momentum[i]); }
-
-double rotational_energy(const ClumpState& s, std::size_t i) {
-  const Vec3 l = s.body_momentum[i], in = s.principal_inertia[i];
-  return 0.5 * (l.x * l.x / in.x + l.y * l.y / in.y + l.z * l.z / in.z);
-}
-
 void step_clump(ClumpState& s, std::size_t i, const Vec3& force, const Vec3& torque, const RigidMotionSettings& m,
                 double dt) {
   using namespace motion;

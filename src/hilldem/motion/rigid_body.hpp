@@ -24,35 +24,11 @@
 // start of the drift (ω = R I⁻¹ Rᵀ L at the orientation at t), so they hold at t + Δt/2 to O(Δt).
 #pragma once
 
-#include <cstdint>
 #include <vector>
 
-#include "hilldem/bodies/ball_store.hpp"
-#include "hilldem/core/quaternion.hpp"
+#include "hilldem/bodies/clump_state.hpp"
 
 namespace hilldem {
-
-// Clumps as structure of arrays, one entry per clump.
-struct ClumpState {
-  std::vector<Vec3> position;           // centre of mass [m], at t
-  std::vector<Vec3> velocity;           // [m/s], at t − Δt/2 (t + Δt/2 after a step)
-  std::vector<Quat> orientation;        // principal frame → global, at t
-  std::vector<Vec3> spin;               // ω [rad/s], global, at t − Δt/2
-  std::vector<Vec3> body_momentum;      // L in the principal frame [kg m²/s], at the orientation at t
-  std::vector<double> mass;             // [kg]
-  std::vector<Vec3> principal_inertia;  // I1, I2, I3 [kg m²]
-  std::vector<FixityMask> fixity;
-
-  std::size_t size() const { return mass.size(); }
-  // Add a clump; L from ω and the inertia at orientation q. Returns the index.
-  std::size_t add(const Vec3& x, const Vec3& v, const Quat& q, const Vec3& omega, double m, const Vec3& inertia,
-                  FixityMask fix = 0);
-};
-
-// L [kg m²/s] and the rotational kinetic energy [J] of clump i in the global frame, from its
-// orientation and body-frame momentum.
-Vec3 angular_momentum(const ClumpState& s, std::size_t i);
-double rotational_energy(const ClumpState& s, std::size_t i);
 
 struct RigidMotionSettings {
   Vec3 gravity;                // g [m/s²]
