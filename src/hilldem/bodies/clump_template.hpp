@@ -68,8 +68,9 @@ struct ClumpTemplate {
   ClumpTemplate scaled_by(double s) const;
   // The template scaled so that its equal-volume diameter is size [m] (the size a grading draws).
   ClumpTemplate scaled(double size) const;
-  // The template with its principal frame turned by q (the frame it was given in rotated by q about
-  // the centre of mass): the orientation a clump made from it starts with. Mass properties unchanged.
+  // The template turned by q about the origin of the frame its pebbles were given in (its orientation
+  // and centre of mass turn): the orientation a clump made from it starts with. Mass properties
+  // unchanged.
   ClumpTemplate rotated(const Quat& q) const;
   // Pebble k's centre [m] in the frame the pebbles were given in (rotated/translated as above).
   Vec3 reference_position(std::size_t k) const;
