@@ -225,6 +225,14 @@ TEST(ClumpTemplate, ScaledAndRotated) {
   for (double& r : big.radius) r *= f;
   const ClumpTemplate direct = make_template(big, 2650.0);
   EXPECT_LT(max_rel(direct.principal_inertia, s.principal_inertia), 1e-12);
+  // the other size measure: the enclosing diameter about the centre of mass
+  const ClumpTemplate e = t.scaled(10e-3, SizeMeasure::EnclosingDiameter);
+  EXPECT_NEAR(e.size(SizeMeasure::EnclosingDiameter), 10e-3, 1e-15);
+  double reach = 0.0;
+  for (std::size_t k = 0; k < 3; ++k) reach = std::max(reach, norm(e.pebbles.position[k]) + e.pebbles.radius[k]);
+  EXPECT_NEAR(2.0 * reach, 10e-3, 1e-15);
+  EXPECT_GT(e.size(SizeMeasure::EnclosingDiameter), e.size(SizeMeasure::EqualVolumeDiameter));
+  EXPECT_LT(e.mass, s.mass);  // the same size by a larger measure is a smaller clump
   // rotated: reference positions turn by q about the origin of the pebbles' frame, mass unchanged
   const Quat q = from_axis_angle({0, 0, 1}, kPi / 3);
   const ClumpTemplate r = t.rotated(q);

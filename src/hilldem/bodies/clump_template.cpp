@@ -199,9 +199,23 @@ ClumpTemplate ClumpTemplate::scaled_by(double s) const {
   return t;
 }
 
-ClumpTemplate ClumpTemplate::scaled(double size) const {
-  if (!(size > 0.0) || !std::isfinite(size)) throw InputError("clump template: size must be > 0 m, got " + std::to_string(size));
-  return scaled_by(size / equal_volume_diameter());
+double ClumpTemplate::size(SizeMeasure measure) const {
+  switch (measure) {
+    case SizeMeasure::EqualVolumeDiameter:
+      return equal_volume_diameter();
+    case SizeMeasure::EnclosingDiameter: {
+      double r = 0.0;
+      for (std::size_t k = 0; k < pebbles.size(); ++k) r = std::max(r, norm(pebbles.position[k]) + pebbles.radius[k]);
+      return 2.0 * r;
+    }
+  }
+  return equal_volume_diameter();
+}
+
+ClumpTemplate ClumpTemplate::scaled(double target, SizeMeasure measure) const {
+  if (!(target > 0.0) || !std::isfinite(target))
+    throw InputError("clump template: size must be > 0 m, got " + std::to_string(target));
+  return scaled_by(target / size(measure));
 }
 
 ClumpTemplate ClumpTemplate::rotated(const Quat& q) const {

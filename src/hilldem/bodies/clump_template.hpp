@@ -48,6 +48,11 @@ Mat3 central_inertia(const GeometricMoments& g);
 
 enum class MassMethod { Exact, Columns, User };
 
+// What a clump's size [m] is: the diameter of the sphere of equal volume, (6V/π)^(1/3) (the
+// default, and what a grading's sizes mean unless stated otherwise), or the diameter of the
+// smallest sphere about the centre of mass that holds every pebble, 2 max_k(|p_k| + r_k).
+enum class SizeMeasure { EqualVolumeDiameter, EnclosingDiameter };
+
 struct ClumpTemplate {
   // Pebbles in the principal frame: centres [m] relative to the centre of mass, radii [m].
   Pebbles pebbles;
@@ -66,8 +71,10 @@ struct ClumpTemplate {
   double equal_volume_diameter() const;
   // The template scaled by factor s [-] about its centre of mass: lengths s, V and m s³, I s⁵.
   ClumpTemplate scaled_by(double s) const;
-  // The template scaled so that its equal-volume diameter is size [m] (the size a grading draws).
-  ClumpTemplate scaled(double size) const;
+  // The size [m] by measure.
+  double size(SizeMeasure measure = SizeMeasure::EqualVolumeDiameter) const;
+  // The template scaled so that its size by measure is size [m] (the size a grading draws).
+  ClumpTemplate scaled(double size, SizeMeasure measure = SizeMeasure::EqualVolumeDiameter) const;
   // The template turned by q about the origin of the frame its pebbles were given in (its orientation
   // and centre of mass turn): the orientation a clump made from it starts with. Mass properties
   // unchanged.
