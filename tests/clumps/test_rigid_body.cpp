@@ -177,3 +177,30 @@ TEST(RigidBody, FixityAndImposedSpin) {
   }
   EXPECT_NE(p.spin[0].x, 1.0);
 }
+
+TEST(RigidBody, AdvanceClumpsIsStepClumpForEach) {
+  // More clumps than kParallelMin, so that the loop runs on threads where there are any.
+  const ClumpTemplate t = asymmetric_clump();
+  ClumpState a;
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<Vec3> f, m;
+  for (std::size_t i = 0; i < kParallelMin + 500; ++i) {
+    a.add({u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, from_rotation_vector({u(rng), u(rng), u(rng)}),
+          Vec3{u(rng), u(rng), u(rng)} * 50.0, t.mass, t.principal_inertia, i % 7 == 0 ? kFixSpin : 0);
+    f.push_back(Vec3{u(rng), u(rng), u(rng)} * 1e-2);
+    m.push_back(Vec3{u(rng), u(rng), u(rng)} * 1e-5);
+  }
+  ClumpState b = a;
+  const RigidMotionSettings rs{{0, 0, -9.81}, 0.7};
+  for (int step = 0; step < 3; ++step) {
+    advance_clumps(a, f, m, rs, 1e-5);
+    for (std::size_t i = 0; i < b.size(); ++i) step_clump(b, i, f[i], m[i], rs, 1e-5);
+  }
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    ASSERT_TRUE(same_bits(a.position[i], b.position[i])) << i;
+    ASSERT_TRUE(same_bits(a.spin[i], b.spin[i])) << i;
+    ASSERT_TRUE(same_bits(a.body_momentum[i], b.body_momentum[i])) << i;
+    ASSERT_EQ(std::memcmp(&a.orientation[i], &b.orientation[i], sizeof(Quat)), 0) << i;
+  }
+}
