@@ -19,12 +19,14 @@ struct Command {
 // A real option's range check, as the TOML keys have: NaN and inf are refused (CLI::Range lets NaN
 // through, since every comparison with NaN is false). The parse error exits with status 2.
 inline CLI::Validator finite_range(double lo, double hi, const std::string& unit) {
-  const std::string range = lo == -HUGE_VAL && hi == HUGE_VAL ? std::string("(-inf, inf)") : fmt::format("[{:g}, {:g}] {}", lo, hi, unit);
+  const bool any = lo == -HUGE_VAL && hi == HUGE_VAL;
+  const std::string range = any ? std::string("finite") : fmt::format("[{:g}, {:g}] {}", lo, hi, unit);
   return CLI::Validator(
-      [lo, hi, range](std::string& text) -> std::string {
+      [lo, hi, range, any](std::string& text) -> std::string {
         double v = 0.0;
-        if (!CLI::detail::lexical_cast(text, v)) return "must be a number in " + range + "; got \"" + text + "\"";
-        if (!std::isfinite(v) || v < lo || v > hi) return "must be a finite number in " + range + "; got " + text;
+        const std::string in = any ? std::string() : " in " + range;
+        if (!CLI::detail::lexical_cast(text, v)) return "must be a number" + in + "; got \"" + text + "\"";
+        if (!std::isfinite(v) || v < lo || v > hi) return "must be a finite number" + in + "; got " + text;
         return "";
       },
       range);
