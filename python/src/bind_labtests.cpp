@@ -14,6 +14,7 @@
 #include "bindings.hpp"
 #include "hilldem/labtests/specimen_io.hpp"
 #include "hilldem/labtests/study.hpp"
+#include "hilldem/labtests/t307.hpp"
 #include "hilldem/verify/verify.hpp"
 #include "py_simulation.hpp"
 
@@ -203,6 +204,85 @@ py::dict triaxial_dict(const TriaxialResult& t) {
   PUT(d, t, seconds);
   d["history_csv"] = t.history_csv();
   d["loops_text"] = t.loops_text();
+  return d;
+}
+
+// A numpy column of T 307 rows or cycles through an accessor: out[k] = get(rows[k]).
+template <class Row, class F>
+py::array_t<double> column_of(const std::vector<Row>& rows, F get) {
+  py::array_t<double> a(static_cast<py::ssize_t>(rows.size()));
+  auto m = a.template mutable_unchecked<1>();
+  for (std::size_t k = 0; k < rows.size(); ++k) m(static_cast<py::ssize_t>(k)) = static_cast<double>(get(rows[k]));
+  return a;
+}
+
+py::dict t307_dict(const T307Result& r) {
+  py::dict rows;  // one entry per sequence run, the conditioning (sequence 0) first if it ran
+  const auto& q = r.rows;
+  rows["sequence"] = column_of(q, [](const T307Row& x) { return x.nominal.number; });
+  rows["sigma3"] = column_of(q, [](const T307Row& x) { return x.nominal.confining; });
+  rows["sigma_max"] = column_of(q, [](const T307Row& x) { return x.nominal.max_stress; });
+  rows["sigma_cyclic"] = column_of(q, [](const T307Row& x) { return x.nominal.cyclic; });
+  rows["sigma_contact"] = column_of(q, [](const T307Row& x) { return x.nominal.contact; });
+  rows["cycles"] = column_of(q, [](const T307Row& x) { return x.cycles; });
+  rows["averaged"] = column_of(q, [](const T307Row& x) { return x.averaged; });
+  rows["cyclic_stress"] = column_of(q, [](const T307Row& x) { return x.cyclic_stress; });
+  rows["max_deviator"] = column_of(q, [](const T307Row& x) { return x.max_deviator; });
+  rows["confining"] = column_of(q, [](const T307Row& x) { return x.confining; });
+  rows["bulk_stress"] = column_of(q, [](const T307Row& x) { return x.bulk_stress; });
+  rows["octahedral_shear"] = column_of(q, [](const T307Row& x) { return x.octahedral_shear; });
+  rows["recoverable_axial"] = column_of(q, [](const T307Row& x) { return x.recoverable_axial; });
+  rows["modulus"] = column_of(q, [](const T307Row& x) { return x.modulus; });
+  rows["poisson"] = column_of(q, [](const T307Row& x) { return x.poisson; });
+  rows["permanent_strain"] = column_of(q, [](const T307Row& x) { return x.permanent_strain; });
+  rows["total_permanent_strain"] = column_of(q, [](const T307Row& x) { return x.total_permanent_strain; });
+  rows["amplitude_error"] = column_of(q, [](const T307Row& x) { return x.amplitude_error; });
+  rows["steps"] = column_of(q, [](const T307Row& x) { return x.steps; });
+  py::dict cycles;
+  const auto& c = r.cycles;
+  cycles["sequence"] = column_of(c, [](const T307Cycle& x) { return x.sequence; });
+  cycles["cycle"] = column_of(c, [](const T307Cycle& x) { return x.cycle; });
+  cycles["q_peak"] = column_of(c, [](const T307Cycle& x) { return x.q_peak; });
+  cycles["q_end"] = column_of(c, [](const T307Cycle& x) { return x.q_end; });
+  cycles["sigma_r_peak"] = column_of(c, [](const T307Cycle& x) { return x.sigma_r_peak; });
+  cycles["recoverable_axial"] = column_of(c, [](const T307Cycle& x) { return x.recoverable_axial; });
+  cycles["recoverable_radial"] = column_of(c, [](const T307Cycle& x) { return x.recoverable_radial; });
+  cycles["eps_a_end"] = column_of(c, [](const T307Cycle& x) { return x.eps_a_end; });
+  cycles["modulus"] = column_of(c, [](const T307Cycle& x) { return x.modulus; });
+  cycles["command"] = column_of(c, [](const T307Cycle& x) { return x.command; });
+  cycles["amplitude_error"] = column_of(c, [](const T307Cycle& x) { return x.amplitude_error; });
+  py::dict d;
+  d["rows"] = rows;
+  d["cycles"] = cycles;
+  PUT(d, r, fitted);
+  if (r.fitted) {
+    py::dict f;
+    PUT(f, r.fit, k1);
+    PUT(f, r.fit, k2);
+    PUT(f, r.fit, k3);
+    PUT(f, r.fit, se_k1);
+    PUT(f, r.fit, se_k2);
+    PUT(f, r.fit, se_k3);
+    PUT(f, r.fit, r_squared);
+    PUT(f, r.fit, rms_error);
+    PUT(f, r.fit, points);
+    PUT(f, r.fit, iterations);
+    PUT(f, r.fit, converged);
+    d["fit"] = f;
+  } else {
+    d["fit"] = py::none();
+  }
+  PUT(d, r, fit_error);
+  PUT(d, r, stopped);
+  PUT(d, r, stop_reason);
+  PUT(d, r, height0);
+  PUT(d, r, radius0);
+  PUT(d, r, timestep);
+  PUT(d, r, steps);
+  PUT(d, r, seconds);
+  d["sequences_csv"] = r.sequences_csv();
+  d["cycles_csv"] = r.cycles_csv();
+  d["text"] = r.text();
   return d;
 }
 
@@ -401,6 +481,34 @@ rows. InputError naming the file, line and value on bad input.)");
       .def_readwrite("final_records", &TriaxialSettings::final_records, "History rows of the final loading [-].")
       .def_readwrite("density_scaling", &TriaxialSettings::density_scaling, "Density scaling factor F [-]: 0 (off) or [1, 50].")
       .def_readwrite("max_steps", &TriaxialSettings::max_steps, "RunError after this many cycles [-].");
+  py::class_<T307Sequence>(lab, "T307Sequence", "One row of the T 307 table (sequence 0: the conditioning).")
+      .def(py::init<>(), "Zeros.")
+      .def_readwrite("number", &T307Sequence::number, "0: conditioning, 1..15 [-].")
+      .def_readwrite("confining", &T307Sequence::confining, "sigma_3 [Pa].")
+      .def_readwrite("max_stress", &T307Sequence::max_stress, "sigma_max, the peak deviator [Pa].")
+      .def_readwrite("cyclic", &T307Sequence::cyclic, "sigma_cyclic, the haversine amplitude [Pa].")
+      .def_readwrite("contact", &T307Sequence::contact, "sigma_contact, the deviator between pulses [Pa].")
+      .def_readwrite("standard_cycles", &T307Sequence::standard_cycles, "Load repetitions in the standard [-].")
+      .def_property_readonly("bulk_stress", &T307Sequence::bulk_stress, "theta = 3 sigma_3 + sigma_max [Pa].")
+      .def_property_readonly("octahedral_shear", &T307Sequence::octahedral_shear, "tau_oct = (sqrt 2/3) sigma_max [Pa].");
+  lab.def("t307_base_sequences", &t307_base_sequences, "The standard's table for base materials: sequences 0..15.");
+  py::class_<T307Timing>(lab, "T307Timing", "The time-scaled variant of T 307 (docs/t307.md).")
+      .def(py::init<>(), "The header's defaults.")
+      .def_readwrite("pulse_duration", &T307Timing::pulse_duration, "Haversine pulse [s].")
+      .def_readwrite("rest_duration", &T307Timing::rest_duration, "Rest after each pulse [s].")
+      .def_readwrite("settle_duration", &T307Timing::settle_duration, "Hold before a sequence's first pulse [s].")
+      .def_readwrite("cycles", &T307Timing::cycles, "Pulses per sequence [-].")
+      .def_readwrite("conditioning_cycles", &T307Timing::conditioning_cycles, "Pulses of the conditioning [-].")
+      .def_readwrite("averaged_cycles", &T307Timing::averaged_cycles, "M_r and nu over the last this many [-].")
+      .def_readwrite("servo_gain", &T307Timing::servo_gain, "alpha_s of the servos [-].")
+      .def_readwrite("wall_speed_limit", &T307Timing::wall_speed_limit, "Servo speed cap [m/s].");
+  py::class_<T307Settings>(lab, "T307Settings", "Settings of t307(): timing, sequences, limits.")
+      .def(py::init<>(), "The header's defaults (the standard's 16 rows).")
+      .def_readwrite("timing", &T307Settings::timing, "T307Timing.")
+      .def_readwrite("sequences", &T307Settings::sequences, "[T307Sequence], run in this order.")
+      .def_readwrite("max_permanent_strain", &T307Settings::max_permanent_strain,
+                     "Stop after the cycle that passes this total permanent axial strain [-].")
+      .def_readwrite("max_steps", &T307Settings::max_steps, "RunError after this many cycles [-].");
   py::class_<CaseSpec>(lab, "CaseSpec", "One case of the study: grading x material, dry or wet.")
       .def(py::init([](std::string grading, GrainModel model, bool wet) { return CaseSpec{std::move(grading), model, wet}; }),
            py::arg("grading") = "C5b", py::arg("model") = GrainModel::Hill, py::arg("wet") = false,
@@ -497,9 +605,26 @@ Specimen. log: print the phases as the CLI does. RunError when a phase does not 
 'worst_platen_mismatch' [-] (and the strains where they happened), 'steps', 'seconds' [s],
 'history_csv', 'loops_text'}. History columns: step, time [s], phase, cycle, eps_a, eps_r, eps_v [-],
 sigma_a, sigma_r, q, sigma_top, sigma_bottom [Pa], porosity, coordination, platen_mismatch [-].
-Loops: cycle, target_strain, eps_a, eps_b [-], q_a, q_b, q_c [Pa], closed, unload_secant (the
-resilient modulus M_r), reload_secant [Pa], loop_area [J/m^3], damping_ratio [-].)");
+Loops: cycle, target_strain, eps_a, eps_b [-], q_a, q_b, q_c [Pa], closed, unload and reload (the
+least-squares fits: slope = M_r on the unload [Pa], slope_se its standard error), unload_secant,
+reload_secant (two-point secants) [Pa], loop_area [J/m^3], damping_ratio [-].)");
   lab.def("memo_cases", &memo_cases, "The memo's five cases: C5n/C5b x linear/hill, plus C5b hill wet.");
+  lab.def("t307", [](Specimen& s, const T307Settings& t, bool log) {
+            validate(t);
+            return t307_dict(released([&] { return run_t307(s, t, log_stream(log)); }));
+          },
+          py::arg("specimen"), py::arg("settings") = T307Settings{}, py::arg("log") = false,
+          R"(AASHTO T 307 (time-scaled, docs/t307.md) on a finalized specimen. Returns {'rows': {column: numpy
+array, one entry per sequence run, the conditioning (sequence 0) first}, 'cycles': {column: numpy
+array, one entry per pulse}, 'fitted', 'fit' ({'k1', 'k2', 'k3' [-], 'se_k1', 'se_k2', 'se_k3' [-],
+'r_squared' [-], 'rms_error' [Pa], 'points', 'iterations', 'converged'} or None), 'fit_error',
+'stopped', 'stop_reason', 'height0', 'radius0' [m], 'timestep' [s], 'steps', 'seconds' [s],
+'sequences_csv', 'cycles_csv', 'text'}. Row columns: sequence, sigma3, sigma_max, sigma_cyclic,
+sigma_contact (nominal, Pa), cycles, averaged, cyclic_stress, max_deviator, confining, bulk_stress,
+octahedral_shear [Pa], recoverable_axial [-], modulus (M_r) [Pa], poisson, permanent_strain,
+total_permanent_strain, amplitude_error [-], steps. Cycle columns: sequence, cycle, q_peak, q_end,
+sigma_r_peak [Pa], recoverable_axial, recoverable_radial, eps_a_end [-], modulus, command [Pa],
+amplitude_error [-].)");
   lab.def("study", [](const StudySettings& s, const std::vector<CaseSpec>& cases, bool log) {
             return study_dict(released([&] { return run_study(s, cases, log_stream(log)); }));
           },

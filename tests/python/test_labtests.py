@@ -147,3 +147,35 @@ def test_bad_lab_input_names_the_value(source_dir, tmp_path):
         st = lab.StudySettings()
         lab.finalize(s, st.material)
         s.save(tmp_path / "x.csv")
+
+
+def test_t307_from_python_is_the_clis(cli, source_dir, tmp_path):
+    """t307 on the finalized miniature specimen (four sequences and the conditioning, three short pulses
+    each): the CLI's t307_sequences.csv and fit, to the byte."""
+    specimen, fine = mini_files(source_dir)
+    cli("t307", "--specimen", specimen, "--grading", fine, "--sequences", "0,1,7,11,14", "--cycles", 3,
+        "--averaged-cycles", 2, "--conditioning-cycles", 1, "--pulse-duration", 5e-3, "--rest-duration", 2e-3,
+        "--no-plot", "-q", "-o", tmp_path)
+    s, _ = lab.load_specimen(specimen)
+    st = lab.StudySettings()
+    material = st.material
+    material.model = lab.GrainModel.Hill
+    lab.finalize(s, material, st.test_walls, st.finalize)
+    t = lab.T307Settings()
+    table = lab.t307_base_sequences()
+    assert [q.number for q in table] == list(range(16)) and table[1].confining == pytest.approx(20.7e3)
+    t.sequences = [table[k] for k in (0, 1, 7, 11, 14)]
+    t.timing.cycles, t.timing.averaged_cycles, t.timing.conditioning_cycles = 3, 2, 1
+    t.timing.pulse_duration, t.timing.rest_duration = 5e-3, 2e-3
+    r = lab.t307(s, t)
+    assert r["sequences_csv"] == (tmp_path / "t307_sequences.csv").read_text()
+    assert r["fitted"] and r["fit"]["r_squared"] <= 1.0 + 1e-12
+    (fit,) = read_csv(tmp_path / "t307_fit.csv")
+    assert r["fit"]["k1"] == pytest.approx(float(next(v for k, v in fit.items() if k.startswith("k1"))), rel=1e-6)
+    rows = r["rows"]
+    assert list(rows["sequence"]) == [0, 1, 7, 11, 14] and np.all(rows["modulus"][1:] > 0)
+    assert len(r["cycles"]["q_peak"]) == 1 + 4 * 3
+    with pytest.raises(hilldem.InputError, match="cycles"):
+        bad = lab.T307Settings()
+        bad.timing.cycles = 0
+        lab.t307(s, bad)
