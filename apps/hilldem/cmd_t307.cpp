@@ -110,12 +110,6 @@ void write_file(const fs::path& path, const std::string& text) {
   if (!f) throw RunError("cannot write " + path.string());
 }
 
-std::string quote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
 int run(const Options& o) {
   const Plan plan = build(o);  // throws InputError (exit 2) before anything is written
   if (o.threads > 0) omp_set_num_threads(o.threads);
@@ -147,19 +141,7 @@ int run(const Options& o) {
   std::cout << "\n" << summary;
   std::cout << fmt::format("outputs: {}/t307_sequences.csv, t307_cycles.csv, {}t307_summary.txt\n", out.string(),
                            r.fitted ? "t307_fit.csv, " : "");
-  if (!o.no_plot) {
-    std::string script = "scripts/plot_t307.py";
-    if (!fs::exists(script)) script = std::string(HILLDEM_SOURCE_DIR) + "/scripts/plot_t307.py";
-    if (!fs::exists(script)) {
-      std::cout << "figure: scripts/plot_t307.py not found; skipped\n";
-    } else {
-      const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-      const std::string cmd = python + " " + quote(script) + " " + quote(out.string());
-      std::cout.flush();
-      if (std::system(cmd.c_str()) != 0)
-        std::cout << "figure: `" << cmd << "` failed (python3-matplotlib missing?); the CSV results stand\n";
-    }
-  }
+  if (!o.no_plot) run_plot_script("scripts/plot_t307.py", out.string(), "figure");
   return 0;
 }
 

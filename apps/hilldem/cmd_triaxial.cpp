@@ -141,18 +141,6 @@ std::pair<StudySettings, std::vector<CaseSpec>> build(const Options& o) {
   return {s, cases};
 }
 
-std::string find_plot_script() {
-  for (const std::string p : {std::string("scripts/plot_triaxial.py"), std::string(HILLDEM_SOURCE_DIR) + "/scripts/plot_triaxial.py"})
-    if (std::filesystem::exists(p)) return p;
-  return "";
-}
-
-std::string quote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
 int run(const Options& o) {
   auto [settings, cases] = build(o);  // throws InputError (exit 2) before anything is written
   // The folder is this process's while it runs (io/output_folder.hpp); an unwritable one is bad input.
@@ -184,19 +172,7 @@ int run(const Options& o) {
   std::cout << "\n" << result.summary_markdown();
   std::cout << fmt::format("\nsummary: {}/summary.csv, {}/summary.md; {:.0f} s wall, {:.0f} s CPU in all\n", settings.output_dir,
                            settings.output_dir, result.seconds, result.cpu_seconds);
-  if (!o.no_plot) {
-    const std::string script = find_plot_script();
-    if (script.empty()) {
-      std::cout << "figures: scripts/plot_triaxial.py not found; skipped\n";
-    } else {
-      // Debian's interpreter is the one python3-matplotlib serves (a python3 earlier on PATH may lack it).
-      const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-      const std::string cmd = python + " " + quote(script) + " " + quote(settings.output_dir);
-      std::cout.flush();
-      const int rc = std::system(cmd.c_str());
-      if (rc != 0) std::cout << "figures: `" << cmd << "` failed (python3-matplotlib missing?); the CSV results stand\n";
-    }
-  }
+  if (!o.no_plot) run_plot_script("scripts/plot_triaxial.py", settings.output_dir, "figures");
   return 0;
 }
 

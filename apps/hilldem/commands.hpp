@@ -33,6 +33,11 @@ inline CLI::Validator finite_range(double lo, double hi, const std::string& unit
 }
 inline CLI::Validator finite_number() { return finite_range(-HUGE_VAL, HUGE_VAL, ""); }
 
+// The figures of a lab command: `/usr/bin/python3 SCRIPT FOLDER` (SCRIPT relative to the working
+// folder, else to the source tree), a line naming `what` if the script is missing or fails (the CSV
+// results stand either way). Defined in plot_script.cpp.
+void run_plot_script(const std::string& script, const std::string& folder, const std::string& what);
+
 // After a run that a signal stopped (RunResult::stopped_by): the message on stderr saying where it
 // stopped and how to resume; returns the exit status, 128 + the signal number. Defined in cmd_resume.cpp.
 int report_stop(int signal, std::int64_t step, double time, const std::string& checkpoint, const std::string& checkpoint_dir);
