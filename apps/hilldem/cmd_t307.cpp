@@ -14,6 +14,7 @@
 
 #include "commands.hpp"
 #include "hilldem/core/error.hpp"
+#include "hilldem/io/output_folder.hpp"
 #include "hilldem/labtests/specimen_io.hpp"
 #include "hilldem/labtests/study.hpp"
 #include "hilldem/labtests/t307.hpp"
@@ -115,7 +116,8 @@ int run(const Options& o) {
   if (o.threads > 0) omp_set_num_threads(o.threads);
   std::ostream* log = o.quiet ? nullptr : &std::cout;
   const fs::path out = o.output;
-  fs::create_directories(out);
+  // The folder is this process's while it runs (io/output_folder.hpp); an unwritable one is bad input.
+  const OutputLock lock(o.output, "-o");
   PackedResult packed = make_packed(plan.study, plan.c.grading, plan.c.model, o.specimen.empty(), log);
   Specimen s = std::move(packed.specimen);
   Class5Material m = plan.study.material;

@@ -39,6 +39,10 @@ add_test(NAME cli.t307_miniature_run_exits_0
                    && test $(wc -l < \"$1/t307_sequences.csv\") -eq 5 && test -s \"$1/t307_fit.csv\" && test -s \"$1/t307_mr_theta.png\" \
                    && ! grep -q nan \"$1/t307_sequences.csv\""
           $<TARGET_FILE:hilldem> ${HILLDEM_T307_OUT}/mini ${HILLDEM_TEST_DATA})
-set_tests_properties(cli.t307_zero_pulse_duration_exits_2 cli.t307_sequence_out_of_range_exits_2 cli.t307_averaged_above_cycles_exits_2
+# Like every command, t307 holds its output folder (io/output_folder.hpp): an unwritable one is bad input.
+add_test(NAME cli.t307_unwritable_output_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "/proc/x" --stderr "cannot create the output folder"
+          2 $<TARGET_FILE:hilldem> t307 -q --no-plot -o /proc/x)
+set_tests_properties(cli.t307_unwritable_output_exits_2 cli.t307_zero_pulse_duration_exits_2 cli.t307_sequence_out_of_range_exits_2 cli.t307_averaged_above_cycles_exits_2
   cli.t307_wet_linear_exits_2 cli.t307_bad_permanent_strain_limit_exits_2 cli.t307_refused_run_writes_nothing
   cli.t307_miniature_run_exits_0 PROPERTIES TIMEOUT 120 LABELS "cli;labtests")
