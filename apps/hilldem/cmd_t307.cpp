@@ -111,13 +111,24 @@ void write_file(const fs::path& path, const std::string& text) {
   if (!f) throw RunError("cannot write " + path.string());
 }
 
+int run_locked(const Options& o, const Plan& plan, std::ostream* log);
+
 int run(const Options& o) {
-  const Plan plan = build(o);  // throws InputError (exit 2) before anything is written
+  Plan plan = build(o);  // throws InputError (exit 2) before anything is written
   if (o.threads > 0) omp_set_num_threads(o.threads);
   std::ostream* log = o.quiet ? nullptr : &std::cout;
-  const fs::path out = o.output;
   // The folder is this process's while it runs (io/output_folder.hpp); an unwritable one is bad input.
   const OutputLock lock(o.output, "-o");
+  plan.study.genesis.interrupt = lab_stop_check();
+  try {
+    return run_locked(o, plan, log);
+  } catch (const Interrupted& e) {
+    return report_lab_stop(e, o.output, "t307");
+  }
+}
+
+int run_locked(const Options& o, const Plan& plan, std::ostream* log) {
+  const fs::path out = o.output;
   PackedResult packed = make_packed(plan.study, plan.c.grading, plan.c.model, o.specimen.empty(), log);
   Specimen s = std::move(packed.specimen);
   Class5Material m = plan.study.material;

@@ -141,10 +141,21 @@ std::pair<StudySettings, std::vector<CaseSpec>> build(const Options& o) {
   return {s, cases};
 }
 
+int run_locked(const Options& o, const StudySettings& settings, const std::vector<CaseSpec>& cases);
+
 int run(const Options& o) {
   auto [settings, cases] = build(o);  // throws InputError (exit 2) before anything is written
   // The folder is this process's while it runs (io/output_folder.hpp); an unwritable one is bad input.
   const OutputLock lock(settings.output_dir, "-o");
+  settings.genesis.interrupt = lab_stop_check();
+  try {
+    return run_locked(o, settings, cases);
+  } catch (const Interrupted& e) {
+    return report_lab_stop(e, settings.output_dir, "triaxial");
+  }
+}
+
+int run_locked(const Options& o, const StudySettings& settings, const std::vector<CaseSpec>& cases) {
   if (o.threads > 0) omp_set_num_threads(o.threads);  // 0: OpenMP's default (OMP_NUM_THREADS or all cores)
   std::ostream* log = o.quiet ? nullptr : &std::cout;
   if (log)

@@ -9,6 +9,8 @@
 #include <memory>
 #include <vector>
 
+#include "hilldem/core/error.hpp"
+
 namespace hilldem::cli {
 
 struct Command {
@@ -41,6 +43,12 @@ void run_plot_script(const std::string& script, const std::string& folder, const
 // After a run that a signal stopped (RunResult::stopped_by): the message on stderr saying where it
 // stopped and how to resume; returns the exit status, 128 + the signal number. Defined in cmd_resume.cpp.
 int report_stop(int signal, std::int64_t step, double time, const std::string& checkpoint, const std::string& checkpoint_dir);
+
+// The lab commands' graceful stop (lab_stop.cpp): lab_stop_check() installs the signal handlers and
+// returns the predicate for GenesisSpec::interrupt; report_lab_stop says where the test stopped and
+// which packed specimens were kept, and returns 128 + the signal number.
+std::function<bool()> lab_stop_check();
+int report_lab_stop(const Interrupted& e, const std::string& output_dir, const std::string& command);
 
 // Options live as long as the app: each add_* keeps its state in a shared_ptr captured by `run`.
 std::vector<Command> add_scenario_commands(CLI::App& app);  // run, check, contacts, quantities

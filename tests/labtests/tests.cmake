@@ -157,3 +157,12 @@ add_test(NAME cli.triaxial_t307_vessel_has_h_over_d_2
 set_tests_properties(cli.triaxial_confinement_sweep_runs_each_case_at_each cli.triaxial_repeated_confinement_exits_2
   cli.triaxial_negative_confinement_in_a_sweep_exits_2 cli.triaxial_unknown_vessel_exits_2 cli.triaxial_t307_vessel_has_h_over_d_2
   PROPERTIES TIMEOUT 120 LABELS "cli;labtests")
+
+# SIGINT / SIGTERM stop a lab test after the cycle it is in: exit 128 + N, a message naming the
+# signal, the step and the packed specimens kept, no results (tests/cli/lab_stop.sh).
+foreach(mode t307 packing)
+  add_test(NAME cli.lab_test_stopped_by_signal_${mode}
+    COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/lab_stop.sh $<TARGET_FILE:hilldem> ${HILLDEM_TEST_DATA} ${mode})
+  set_tests_properties(cli.lab_test_stopped_by_signal_${mode} PROPERTIES TIMEOUT 300 LABELS "cli;labtests;reliability"
+                       ENVIRONMENT OMP_NUM_THREADS=1)
+endforeach()

@@ -307,5 +307,42 @@ TEST(Cycle, StoppedByTheHookIsTheStateOfThatManyCycles) {
   EXPECT_EQ(state_difference(hooked, plain), "");
 }
 
+// Simulation::interrupt: once it answers true, that cycle is the last and the call throws Interrupted
+// naming the step; the state is bitwise that many cycles', in cycle() and in solve().
+TEST(Cycle, InterruptEndsTheCallAfterThatCycleWithInterrupted) {
+  auto make = [] {
+    Simulation sim = random_box(200, 3);
+    sim.settings.gravity = {0, 0, -9.81};
+    sim.settings.local_damping = 0.7;
+    sim.make_wet(20e3, 1e-3);
+    return sim;
+  };
+  Simulation hooked = make(), plain = make();
+  int asked = 0;
+  hooked.interrupt = [&] { return ++asked == 37; };
+  try {
+    hooked.cycle(1000);
+    ADD_FAILURE() << "cycle() did not throw Interrupted";
+  } catch (const Interrupted& e) {
+    EXPECT_NE(std::string(e.what()).find("after step 37 "), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(hooked.steps, 37);
+  plain.cycle(37);
+  EXPECT_EQ(state_difference(hooked, plain), "");
+  // solve(): the cycle asked about runs, and the call throws unless the ratio is met by it.
+  asked = 0;
+  hooked.interrupt = [&] { return ++asked == 5; };
+  EXPECT_THROW(hooked.solve(1e-12, 1000), Interrupted);
+  EXPECT_EQ(hooked.steps, 42);
+  plain.solve(1e-12, 5);
+  EXPECT_EQ(state_difference(hooked, plain), "");
+  // Copied with the simulation, and an answer of false changes nothing.
+  hooked.interrupt = [] { return false; };
+  Simulation copy = hooked;
+  EXPECT_EQ(copy.cycle(25, {}), 25);
+  plain.cycle(25);
+  EXPECT_EQ(state_difference(copy, plain), "");
+}
+
 }  // namespace
 }  // namespace hilldem

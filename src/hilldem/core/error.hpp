@@ -19,6 +19,14 @@ class RunError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// A run stopped on request (Simulation::interrupt answered true: the CLI caught SIGINT, SIGTERM or
+// SIGHUP) after a complete cycle; the message says at which step. The CLI exits with 128 + the
+// signal number.
+class Interrupted : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 // Out of memory, caught where a phase begins or ends (std::bad_alloc): what was being allocated and
 // roughly how much, so that the user can size the machine or the job. Exit status 1.
 class OutOfMemory : public std::runtime_error {

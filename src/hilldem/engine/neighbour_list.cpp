@@ -36,20 +36,47 @@ void wrap_positions(BallStore& balls, const PeriodicBox& box) {
       }
 }
 
-// The candidate pairs within reach [m], sorted by key (ball-ball with their periodic image).
-std::vector<std::pair<ContactKey, ImageCode>> candidates(const BallStore& balls, const WallStore& walls,
-                                                         const PeriodicBox& box, double reach) {
-  std::vector<PairCandidate> pairs = find_pair_candidates(balls.position, balls.radius, reach, box);
-  std::vector<std::pair<ContactKey, ImageCode>> all;
-  all.reserve(pairs.size());
+using Candidates = std::vector<std::pair<ContactKey, ImageCode>>;
+
+void sort_by_key(Candidates& all) {
+  std::sort(all.begin(), all.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+}
+
+// The ball-ball pairs within reach [m] of balls at `position` [m], with their periodic image.
+void add_pair_candidates(Candidates& all, const std::vector<Vec3>& position, const BallStore& balls,
+                         const PeriodicBox& box, double reach) {
+  const std::vector<PairCandidate> pairs = find_pair_candidates(position, balls.radius, reach, box);
+  all.reserve(all.size() + pairs.size());
   for (const PairCandidate& p : pairs) all.push_back({{p.i, ContactKind::BallBall, p.j}, p.image});
+}
+
+// The candidate pairs within reach [m], sorted by key (ball-ball with their periodic image).
+Candidates candidates(const BallStore& balls, const WallStore& walls, const PeriodicBox& box, double reach) {
+  Candidates all;
+  add_pair_candidates(all, balls.position, balls, box, reach);
   for (std::uint32_t w = 0; w < walls.size(); ++w)
     for (std::uint32_t i = 0; i < balls.size(); ++i) {
       const auto touch = wall_touch(walls.walls[w], balls.position[i], balls.radius[i]);
       if (touch && touch->gap <= reach) all.push_back({{i, ContactKind::BallWall, w}, kNoImage});
     }
-  std::sort(all.begin(), all.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+  sort_by_key(all);
   return all;
+}
+
+// A candidate that is not a row yet: a new row with its assignment rule's model and parameters, or,
+// if no rule matches, counted in `unassigned`.
+void append_candidate(ContactStore& next, const ContactKey& key, ImageCode image, const BallStore& balls,
+                      const WallStore& walls, const ModelTable& table, const NeighbourList::MapRow& map_row,
+                      std::size_t& unassigned) {
+  const std::uint64_t groups2 = key.kind == ContactKind::BallBall ? balls.groups[key.b] : walls.walls[key.b].groups;
+  const int r = table.match(key.kind, balls.groups[key.a], groups2);
+  if (r < 0) {
+    ++unassigned;
+    return;
+  }
+  const ModelRule& rule = table.rules[r];
+  next.append_new(key, image, r, rule.model, rule.linear, rule.hill, Vec3{0, 0, 1});
+  map_row(next, next.size() - 1);
 }
 }  // namespace
 
@@ -78,17 +105,35 @@ void NeighbourList::rebuild(ContactStore& contacts, BallStore& balls, const Wall
       next.image.back() = image;
       continue;
     }
-    const std::uint64_t groups2 = key.kind == ContactKind::BallBall ? balls.groups[key.b] : walls.walls[key.b].groups;
-    const int r = table.match(key.kind, balls.groups[key.a], groups2);
-    if (r < 0) {
-      ++unassigned_pairs_;
-      continue;
-    }
-    const ModelRule& rule = table.rules[r];
-    next.append_new(key, image, r, rule.model, rule.linear, rule.hill, Vec3{0, 0, 1});
-    map_row(next, next.size() - 1);
+    append_candidate(next, key, image, balls, walls, table, map_row, unassigned_pairs_);
   }
   while (o < contacts.size()) keep_old_if_needed(o++);
+  contacts = std::move(next);
+}
+
+void NeighbourList::restore_rows(ContactStore& contacts, const BallStore& balls, const WallStore& walls,
+                                 const ModelTable& table, const PeriodicBox& box, double reach,
+                                 const MapRow& map_row) const {
+  // The last rebuild's candidates are those at its positions (wrapped into the box then), found by
+  // the same search; the saved rows (every contact, every wall row) stay as they were saved, and
+  // the other ball-ball candidates become rows as the rebuild made them (a new row's columns are
+  // those a contact forming on it resets: create_contact).
+  Candidates pairs;
+  add_pair_candidates(pairs, position_at_build_, balls, box, reach);
+  sort_by_key(pairs);
+  ContactStore next;
+  next.key.reserve(contacts.size() + pairs.size());
+  std::size_t unassigned = 0;  // (the saved count is the rebuild's, walls included)
+  std::size_t o = 0;
+  for (const auto& [key, image] : pairs) {
+    while (o < contacts.size() && contacts.key[o] < key) next.append_row(contacts, o++);
+    if (o < contacts.size() && contacts.key[o] == key) {
+      next.append_row(contacts, o++);
+      continue;
+    }
+    append_candidate(next, key, image, balls, walls, table, map_row, unassigned);
+  }
+  while (o < contacts.size()) next.append_row(contacts, o++);
   contacts = std::move(next);
 }
 

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdio>
 #include <limits>
 #include <numeric>
 
@@ -22,9 +23,11 @@ void Simulation::cycle(std::int64_t n) { cycle(n, {}); }
 std::int64_t Simulation::cycle(std::int64_t n, const std::function<bool()>& stop) {
   drop_records();  // the caller may have changed the columns since the last call
   for (std::int64_t k = 0; k < n; ++k) {
-    const bool last = k + 1 == n || (stop && stop());
+    const bool interrupted = interrupt && interrupt();
+    const bool last = k + 1 == n || interrupted || (stop && stop());
     steps_ahead_ = last ? 0 : n - 1 - k;  // (whether the live records pay: force_pass)
     step_once(last);
+    if (interrupted) throw_interrupted();
     if (last) {
       steps_ahead_ = 0;
       return k + 1;
@@ -38,10 +41,18 @@ std::int64_t Simulation::solve(double ratio, std::int64_t max_steps) {
   // At least one cycle: forces may be stale (make_wet changes them only on the next cycle, §2.7).
   drop_records();
   for (std::int64_t k = 1; k <= max_steps; ++k) {
+    const bool interrupted = interrupt && interrupt();
     step_once(true);  // the ratio reads the contact results
     if (mean_unbalanced_ratio() <= ratio) return k;
+    if (interrupted) throw_interrupted();
   }
   return -1;
+}
+
+void Simulation::throw_interrupted() const {
+  char t[32];
+  std::snprintf(t, sizeof t, "%.6g", time);
+  throw Interrupted("stopped on request after step " + std::to_string(steps) + " (time " + t + " s)");
 }
 
 void Simulation::update_forces() {
@@ -230,6 +241,9 @@ void Simulation::restore_cycle_state(CycleState s) {
   const bool rebuild_needed = s.rebuild_needed || s.position_at_build.empty();  // (before the move below)
   neighbours_.restore(rebuild_needed, s.rebuilds, static_cast<std::size_t>(s.unassigned_pairs),
                       std::move(s.position_at_build), s.wall_travel);
+  if (!rebuild_needed && !s.rows_complete)
+    neighbours_.restore_rows(contacts, balls, walls, table, settings.box, settings.proximity + skin(),
+                             [this](ContactStore& store, std::size_t c) { compute_mapping(balls, store, c); });
   body_terms_ready_ = false;
   build_row_lists();
 }

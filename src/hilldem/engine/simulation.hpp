@@ -70,6 +70,12 @@ class Simulation {
   // Cycle (at least once) until the mean unbalanced-force ratio is ≤ ratio; returns the cycles
   // used, or -1 if max_steps passed first. (Every cycle's contact results are written.)
   std::int64_t solve(double ratio, std::int64_t max_steps);
+  // When set, asked before every cycle of cycle() and solve(): once it answers true, that cycle is
+  // the last (its results written, as at the end of cycle(k)) and the call throws Interrupted. For
+  // drivers that run many calls of their own (the lab tests): their CLI commands set it to answer
+  // SIGINT, SIGTERM and SIGHUP, so a test stops between two cycles with a message. Copied with the
+  // Simulation; not part of its state (checkpoints, digests).
+  std::function<bool()> interrupt;
 
   // Δt the next cycle will use [s].
   double next_timestep() const;
@@ -128,8 +134,9 @@ class Simulation {
 
   CycleState cycle_state() const;
   // Put back a saved CycleState, with the contact rows and ball columns it was saved with: the per-ball
-  // row lists are rebuilt from the current rows (no detection, no merge). Throws RunError if the
-  // state does not fit the balls.
+  // row lists are rebuilt from the current rows (no detection; with rows_complete false, the
+  // neighbour rows that are not contacts made again as the last rebuild made them). Throws RunError
+  // if the state does not fit the balls.
   void restore_cycle_state(CycleState s);
 
   ContactGeometry geometry(std::size_t c) const;
@@ -140,6 +147,7 @@ class Simulation {
   std::size_t unassigned_pairs() const { return neighbours_.unassigned_pairs(); }
 
  private:
+  [[noreturn]] void throw_interrupted() const;
   // One cycle; `last`: the last of a cycle() call (its contact results are written).
   void step_once(bool last);
   void step_body(bool last);  // step_once's work (step_once syncs the columns if it throws)

@@ -41,6 +41,10 @@ struct CycleState {
   std::uint64_t unassigned_pairs = 0;
   std::vector<Vec3> position_at_build;  // [m] ball positions at the last rebuild
   double wall_travel = 0.0;             // [m] bound on wall motion since then
+  // Whether the contact rows are the whole neighbour list; false: only the contacts and the wall
+  // rows (a checkpoint), and the ball-ball rows that are not contacts are made again from
+  // position_at_build (NeighbourList::restore_rows).
+  bool rows_complete = true;
 };
 
 }  // namespace hilldem

@@ -237,6 +237,7 @@ Specimen make_cloud(const GenesisSpec& spec) {
   s.pressure = p.equilibrium.pressure;
   s.packed_with = p.contact.model;
   Simulation& sim = s.sim;
+  sim.interrupt = spec.interrupt;
   sim.settings.local_damping = p.local_damping;
   sim.settings.auto_timestep = true;
   const std::uint64_t grain_bit = sim.groups.bit(kGrainGroup);

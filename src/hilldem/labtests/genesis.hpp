@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <iosfwd>
 #include <string>
 #include <vector>
@@ -73,6 +74,10 @@ struct GenesisSpec {
   // material's model and friction are not used here (packing.contact says how grains are packed).
   Class5Material grain;
   PackingSettings packing;
+  // Not physics: given to every Simulation made from this spec (Simulation::interrupt), and by
+  // make_packed to a specimen it loads, so that a lab test stops between two cycles when it
+  // answers true (the CLI: on SIGINT, SIGTERM, SIGHUP), throwing Interrupted.
+  std::function<bool()> interrupt;
 };
 // Throws InputError naming the first bad value.
 void validate(const GenesisSpec& spec);

@@ -453,6 +453,7 @@ PackedResult make_packed(const StudySettings& settings, const std::string& gradi
   ps.contact.model = model;
   if (!settings.specimen_file.empty()) {
     p.specimen = load_packed_specimen(settings.specimen_file, &ps);
+    p.specimen.sim.interrupt = settings.genesis.interrupt;
     p.file = settings.specimen_file;
     if (log)
       *log << fmt::format("specimen {}: {} grains of {} packed at {:g} kPa (seed {})\n", settings.specimen_file,

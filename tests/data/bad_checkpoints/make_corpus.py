@@ -218,14 +218,14 @@ def main(src, out):
     files["settings_keep_zero.hdc"] = build(mutated(keep_zero))
 
     # sim.cycle: forces_ready u8, rebuild_needed u8, rebuilds i64, unassigned u64, positions column
-    # (u64 count, u32 element size, data), wall travel f64.
+    # (u64 count, u32 element size, data), wall travel f64; version 2: then rows complete u8.
     def cycle_rebuilds_negative(s):
         struct.pack_into("<q", section(s, "sim.cycle")[2], 2, -5)
     files["cycle_rebuilds_negative.hdc"] = build(mutated(cycle_rebuilds_negative))
 
     def cycle_wall_travel_nan(s):
-        p = section(s, "sim.cycle")[2]
-        struct.pack_into("<d", p, len(p) - 8, float("nan"))
+        _, version, p = section(s, "sim.cycle")
+        struct.pack_into("<d", p, len(p) - 8 - (1 if version >= 2 else 0), float("nan"))
     files["cycle_wall_travel_nan.hdc"] = build(mutated(cycle_wall_travel_nan))
 
     def cycle_positions_for_other_balls(s):
