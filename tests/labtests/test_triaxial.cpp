@@ -686,5 +686,47 @@ TEST(Study, FindingsAreComputedFromTheNumbers) {
   EXPECT_NE(r.findings()[1].find("HOLDS IN PART (1 of 2 comparisons; 1 within noise)"), std::string::npos) << r.findings()[1];
 }
 
+// Where the time goes: a packing shared by two cases is listed once, every case phase and test has
+// its row, grain-steps are grains × steps and their shares add up to 100 %.
+TEST(Study, TimeTableListsEachPackingOnceAndEveryCasePhase) {
+  auto phase = [](const std::string& name, std::size_t grains, std::int64_t steps, double seconds) {
+    PhaseReport p;
+    p.name = name;
+    p.state.grains = grains;
+    p.steps = steps;
+    p.seconds = seconds;
+    return p;
+  };
+  auto make = [&](bool wet) {
+    CaseResult c;
+    c.spec = {"C5b", GrainModel::Hill, wet};
+    c.grading.name = "C5b";
+    c.packed_with = GrainModel::Hill;
+    c.phases = {phase("cloud", 1000, 2000, 1.0), phase("packing", 1000, 100000, 50.0), phase("finalize C5b_Hill", 1000, 5000, 2.5)};
+    if (wet) c.phases.push_back(phase("wet C5b_Hill", 1000, 6000, 3.0));
+    c.initial.grains = 1000;
+    c.test.steps = wet ? 140000 : 110000;
+    c.test.seconds = wet ? 80.0 : 60.0;
+    return c;
+  };
+  StudyResult r;
+  r.cases = {make(false), make(true)};
+  const std::string t = r.time_markdown();
+  auto count = [&](const std::string& s) {
+    std::size_t n = 0;
+    for (std::size_t p = t.find(s); p != std::string::npos; p = t.find(s, p + 1)) ++n;
+    return n;
+  };
+  EXPECT_EQ(count("| packing C5b hill: servo packing | 1000 | 100000 | 100.0 |"), 1u) << t;
+  EXPECT_EQ(count("| packing C5b hill: cloud relaxation | 1000 | 2000 | 2.0 |"), 1u) << t;
+  EXPECT_EQ(count("| C5b_Hill: finalize C5b_Hill | 1000 | 5000 | 5.0 |"), 1u) << t;
+  EXPECT_EQ(count("| C5b_Hill_wet: finalize C5b_Hill | 1000 | 5000 | 5.0 |"), 1u) << t;
+  EXPECT_EQ(count("| C5b_Hill_wet: wet C5b_Hill | 1000 | 6000 | 6.0 |"), 1u) << t;
+  EXPECT_EQ(count("| C5b_Hill_wet: triaxial test | 1000 | 140000 | 140.0 | 38.0 | 80.0 | 0.571 |"), 1u) << t;
+  // 2,000 + 100,000 + 2 × 5,000 + 6,000 + 110,000 + 140,000 = 368,000 steps of 1,000 grains; 199 s.
+  EXPECT_EQ(count("| all rows | | 368000 | 368.0 | 100.0 | 199.0 | 0.541 |"), 1u) << t;
+  EXPECT_NE(r.summary_markdown().find("Where the time goes"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace hilldem

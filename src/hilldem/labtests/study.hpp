@@ -85,7 +85,12 @@ struct StudyResult {
   double seconds = 0.0;                 // wall clock [s]
   double cpu_seconds = 0.0;             // process CPU time, all threads [s]
   std::string summary_csv() const;
-  std::string summary_markdown() const;  // the table and the findings
+  std::string summary_markdown() const;  // the table, the findings and time_markdown()
+  // Where the time went: one row per packing (cloud relaxation, servo packing) and per phase of each
+  // case (finalize, wet, confine, triaxial test) with its grains, steps, grain-steps (grains × steps:
+  // a step's cost grows with the grains), share of all grain-steps and wall-clock seconds. With
+  // several jobs at once the seconds of different rows overlap and include the waits for the cores.
+  std::string time_markdown() const;
   std::vector<std::string> findings() const;  // the memo's qualitative claims, each with numbers and a verdict
 };
 
