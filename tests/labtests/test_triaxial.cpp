@@ -507,12 +507,31 @@ TEST(Study, MinGrainsScalesUpTheVesselOfACoarseGrading) {
   const double n_half = expected_grains(n, 1.0, 0.0425, 0.120, 0.58);
   EXPECT_GT(n_half, 90);  // about 110 grains of 14-20 mm in the half-size vessel
   EXPECT_LT(n_half, 130);
+  st.min_grains = 0;
   EXPECT_EQ(vessel_for(st, n), std::make_pair(0.0425, 0.120));  // min_grains 0: as given
   st.min_grains = 500;
   const auto [rn, hn] = vessel_for(st, n);
   EXPECT_NEAR(rn / 0.0425, hn / 0.120, 1e-12);  // the same shape
   EXPECT_NEAR(expected_grains(n, 1.0, rn, hn, 0.58), 500, 1e-6);
   EXPECT_EQ(vessel_for(st, b), std::make_pair(0.0425, 0.120));  // C5b holds ~1,700: never scaled down
+}
+
+// StudySettings{} is the CLI's default study (`hilldem triaxial --study`): the memo's vessel scaled by
+// 0.5, each grading's scaled up to hold 500 grains (C5n: 0.83), not the memo's full vessel.
+TEST(Study, DefaultSettingsAreTheCLIsDefaultStudy) {
+  const StudySettings st;
+  EXPECT_DOUBLE_EQ(st.genesis.vessel_radius, 0.0425);
+  EXPECT_DOUBLE_EQ(st.genesis.vessel_height, 0.120);
+  EXPECT_EQ(st.min_grains, 500);
+  EXPECT_EQ(vessel_for(st, grading_c5b()), std::make_pair(0.0425, 0.120));
+  const auto [rn, hn] = vessel_for(st, grading_c5n());
+  EXPECT_NEAR(rn / kMemoVesselRadius, 0.83, 0.01);
+  EXPECT_NEAR(hn / kMemoVesselHeight, 0.83, 0.01);
+  // Everything else is the genesis defaults.
+  const GenesisSpec g;
+  EXPECT_EQ(st.genesis.grading.name, g.grading.name);
+  EXPECT_EQ(st.genesis.packing.seed, g.packing.seed);
+  EXPECT_EQ(st.genesis.packing.equilibrium.pressure, g.packing.equilibrium.pressure);
 }
 
 TEST(Study, ImpossibleStatesAndResultsAreNamed) {
