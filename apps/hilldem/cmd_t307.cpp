@@ -25,7 +25,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr double kMemoRadius = 0.085, kMemoHeight = 0.240;  // the memo's vessel [m]
+constexpr double kMemoRadius = kMemoVesselRadius, kMemoHeight = kMemoVesselHeight;  // the memo's vessel [m]
 
 struct Options {
   std::string grading = "C5b";
@@ -66,6 +66,7 @@ Plan build(const Options& o) {
   StudySettings& s = p.study;
   s.genesis.vessel_radius = kMemoRadius * o.scale;
   s.genesis.vessel_height = kMemoHeight * o.scale;
+  s.min_grains = 0;  // --scale is the specimen's size, not scaled up for a grain count
   if (o.seed < 0) throw InputError(fmt::format("--seed must be >= 0, got {}", o.seed));
   s.genesis.packing.seed = static_cast<std::uint64_t>(o.seed);
   if (!(o.packing_pressure > 0) || !std::isfinite(o.packing_pressure))

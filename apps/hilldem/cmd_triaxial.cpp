@@ -24,13 +24,11 @@ namespace hilldem::cli {
 
 namespace {
 
-// Memo vessel: 170 mm x 240 mm; AASHTO T 307's specimen for aggregate base: 152 mm x 305 mm (H/D = 2).
-// The default specimen is the memo's vessel scaled by kDefaultScale, each grading's scaled up until it
-// holds kDefaultMinGrains grains (C5n: 0.83; C5b stays at 0.5).
-constexpr double kMemoRadius = 0.085, kMemoHeight = 0.240;
-constexpr double kT307Radius = 0.076, kT307Height = 0.305;
-constexpr double kDefaultScale = 0.5;
-constexpr int kDefaultMinGrains = 500;
+// The vessels and the default study's scale and grain count are the library's (labtests/study.hpp):
+// the CLI's default study is StudySettings{}'s.
+constexpr double kMemoRadius = kMemoVesselRadius, kMemoHeight = kMemoVesselHeight;
+constexpr double kT307Radius = kT307VesselRadius, kT307Height = kT307VesselHeight;
+constexpr double kDefaultScale = kDefaultVesselScale;
 
 struct Options {
   bool study = false;

@@ -461,8 +461,8 @@ rows. InputError naming the file, line and value on bad input.)");
       .def(py::init<>(), "The header's defaults.")
       .def_readwrite("grading", &GenesisSpec::grading, "Grading (default C5b).")
       .def_readwrite("d_mult", &GenesisSpec::d_mult, "Diameter multiplier D_mult [-].")
-      .def_readwrite("vessel_radius", &GenesisSpec::vessel_radius, "Vessel radius [m] (default the memo's 0.085).")
-      .def_readwrite("vessel_height", &GenesisSpec::vessel_height, "Vessel height [m] (default the memo's 0.240).")
+      .def_readwrite("vessel_radius", &GenesisSpec::vessel_radius, "Vessel radius [m] (default the memo's 0.085; StudySettings' default 0.0425).")
+      .def_readwrite("vessel_height", &GenesisSpec::vessel_height, "Vessel height [m] (default the memo's 0.240; StudySettings' default 0.120).")
       .def_readwrite("grain", &GenesisSpec::grain, "Class5Material whose density, E and nu the grains take.")
       .def_readwrite("packing", &GenesisSpec::packing, "PackingSettings.");
   py::class_<TriaxialSettings>(lab, "TriaxialSettings", "The servo-controlled triaxial test (lab-tests.md §4).")
@@ -520,8 +520,10 @@ rows. InputError naming the file, line and value on bad input.)");
       .def_property_readonly("name", &CaseSpec::name, "The case's name, e.g. C5b_Hill_wet.")
       .def("__repr__", [](const CaseSpec& c) { return "CaseSpec('" + c.name() + "')"; }, "Its name.");
   py::class_<StudySettings>(lab, "StudySettings", R"(Settings of study(): genesis, material, finalization, wetting, the
-triaxial test, output. Defaults are the headers' (the memo's full 170 mm x 240 mm vessel; the CLI's
-default is half that: genesis.vessel_radius = 0.0425, vessel_height = 0.120).)")
+triaxial test, output. Defaults are the CLI's default study: the memo's vessel scaled by 0.5
+(genesis.vessel_radius = 0.0425, vessel_height = 0.120), each grading's scaled up to hold min_grains =
+500 grains; the memo's full 170 mm x 240 mm vessel is vessel_radius = 0.085, vessel_height = 0.240,
+min_grains = 0 (the CLI's --full).)")
       .def(py::init<>(), "The header's defaults.")
       .def_readwrite("genesis", &StudySettings::genesis, "GenesisSpec (its grading is replaced by each case's).")
       .def_readwrite("material", &StudySettings::material, "Class5Material (its model is replaced by each case's).")

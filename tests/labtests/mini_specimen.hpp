@@ -35,6 +35,7 @@ inline StudySettings mini_study_from_saved(const std::filesystem::path& dir) {
   save_packed_specimen(mini_packed(), mini_spec().packing, file);
   StudySettings st;
   st.genesis = mini_spec();
+  st.min_grains = 0;  // the miniature vessel as it is
   st.specimen_file = file;
   st.output_dir = (dir / "out").string();
   return st;

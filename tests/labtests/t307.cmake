@@ -46,3 +46,15 @@ add_test(NAME cli.t307_unwritable_output_exits_2
 set_tests_properties(cli.t307_unwritable_output_exits_2 cli.t307_zero_pulse_duration_exits_2 cli.t307_sequence_out_of_range_exits_2 cli.t307_averaged_above_cycles_exits_2
   cli.t307_wet_linear_exits_2 cli.t307_bad_permanent_strain_limit_exits_2 cli.t307_refused_run_writes_nothing
   cli.t307_miniature_run_exits_0 PROPERTIES TIMEOUT 120 LABELS "cli;labtests")
+# The time-scaling figure: the miniature run and one with a longer pulse, M_r against the pulse duration
+# (scripts/plot_t307.py --against-pulse prints each sequence's M_r at both pulses, in pulse order).
+add_test(NAME cli.t307_plot_against_pulse
+  COMMAND bash -c "rm -rf \"$1/pulse8\"; \"$0\" t307 --specimen \"$2/labtests/mini_packed.csv\" --grading \"$2/labtests/fine.csv\" \
+                   --sequences 0,1,7 --cycles 3 --averaged-cycles 2 --conditioning-cycles 1 --pulse-duration 8e-3 \
+                   --rest-duration 2e-3 -q --no-plot -o \"$1/pulse8\" > /dev/null \
+                   && /usr/bin/python3 \"$3/scripts/plot_t307.py\" --against-pulse \"$1/mini\" \"$1/pulse8\" --out \"$1/pulse.png\" > \"$1/pulse.txt\" \
+                   && grep -Eq '^fine_Hill seq 1: 5 ms \\(3 cycles\\) [0-9.]+ MPa, 8 ms \\(3 cycles\\) [0-9.]+ MPa$' \"$1/pulse.txt\" \
+                   && grep -q '^fine_Hill seq 7: 5 ms' \"$1/pulse.txt\" && test -s \"$1/pulse.png\""
+          $<TARGET_FILE:hilldem> ${HILLDEM_T307_OUT} ${HILLDEM_TEST_DATA} ${PROJECT_SOURCE_DIR})
+set_tests_properties(cli.t307_miniature_run_exits_0 PROPERTIES FIXTURES_SETUP t307_mini)
+set_tests_properties(cli.t307_plot_against_pulse PROPERTIES FIXTURES_REQUIRED t307_mini TIMEOUT 120 LABELS "cli;labtests")

@@ -188,6 +188,7 @@ TEST(Study, EachMaterialIsPackedWithItsOwnModelUnlessPackLinear) {
   std::filesystem::remove_all(dir);
   StudySettings st;
   st.genesis = small_spec(GrainModel::Hill);
+  st.min_grains = 0;  // the small vessel as it is
   st.output_dir = dir.string();
   st.jobs = 1;
   const std::string grading = std::string(HILLDEM_SOURCE_DIR) + "/tests/data/labtests/fine.csv";

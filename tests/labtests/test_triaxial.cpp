@@ -507,12 +507,31 @@ TEST(Study, MinGrainsScalesUpTheVesselOfACoarseGrading) {
   const double n_half = expected_grains(n, 1.0, 0.0425, 0.120, 0.58);
   EXPECT_GT(n_half, 90);  // about 110 grains of 14-20 mm in the half-size vessel
   EXPECT_LT(n_half, 130);
+  st.min_grains = 0;
   EXPECT_EQ(vessel_for(st, n), std::make_pair(0.0425, 0.120));  // min_grains 0: as given
   st.min_grains = 500;
   const auto [rn, hn] = vessel_for(st, n);
   EXPECT_NEAR(rn / 0.0425, hn / 0.120, 1e-12);  // the same shape
   EXPECT_NEAR(expected_grains(n, 1.0, rn, hn, 0.58), 500, 1e-6);
   EXPECT_EQ(vessel_for(st, b), std::make_pair(0.0425, 0.120));  // C5b holds ~1,700: never scaled down
+}
+
+// StudySettings{} is the CLI's default study (`hilldem triaxial --study`): the memo's vessel scaled by
+// 0.5, each grading's scaled up to hold 500 grains (C5n: 0.83), not the memo's full vessel.
+TEST(Study, DefaultSettingsAreTheCLIsDefaultStudy) {
+  const StudySettings st;
+  EXPECT_DOUBLE_EQ(st.genesis.vessel_radius, 0.0425);
+  EXPECT_DOUBLE_EQ(st.genesis.vessel_height, 0.120);
+  EXPECT_EQ(st.min_grains, 500);
+  EXPECT_EQ(vessel_for(st, grading_c5b()), std::make_pair(0.0425, 0.120));
+  const auto [rn, hn] = vessel_for(st, grading_c5n());
+  EXPECT_NEAR(rn / kMemoVesselRadius, 0.83, 0.01);
+  EXPECT_NEAR(hn / kMemoVesselHeight, 0.83, 0.01);
+  // Everything else is the genesis defaults.
+  const GenesisSpec g;
+  EXPECT_EQ(st.genesis.grading.name, g.grading.name);
+  EXPECT_EQ(st.genesis.packing.seed, g.packing.seed);
+  EXPECT_EQ(st.genesis.packing.equilibrium.pressure, g.packing.equilibrium.pressure);
 }
 
 TEST(Study, ImpossibleStatesAndResultsAreNamed) {
@@ -684,6 +703,48 @@ TEST(Study, FindingsAreComputedFromTheNumbers) {
   // A C5n fit too uncertain to tell: that stiffness comparison is within noise, the claim holds in part.
   r.cases[0].test.loops[0].unload.slope_se = 40e6;  // C5n linear 100 +- 40 vs C5b linear 150 +- 1
   EXPECT_NE(r.findings()[1].find("HOLDS IN PART (1 of 2 comparisons; 1 within noise)"), std::string::npos) << r.findings()[1];
+}
+
+// Where the time goes: a packing shared by two cases is listed once, every case phase and test has
+// its row, grain-steps are grains × steps and their shares add up to 100 %.
+TEST(Study, TimeTableListsEachPackingOnceAndEveryCasePhase) {
+  auto phase = [](const std::string& name, std::size_t grains, std::int64_t steps, double seconds) {
+    PhaseReport p;
+    p.name = name;
+    p.state.grains = grains;
+    p.steps = steps;
+    p.seconds = seconds;
+    return p;
+  };
+  auto make = [&](bool wet) {
+    CaseResult c;
+    c.spec = {"C5b", GrainModel::Hill, wet};
+    c.grading.name = "C5b";
+    c.packed_with = GrainModel::Hill;
+    c.phases = {phase("cloud", 1000, 2000, 1.0), phase("packing", 1000, 100000, 50.0), phase("finalize C5b_Hill", 1000, 5000, 2.5)};
+    if (wet) c.phases.push_back(phase("wet C5b_Hill", 1000, 6000, 3.0));
+    c.initial.grains = 1000;
+    c.test.steps = wet ? 140000 : 110000;
+    c.test.seconds = wet ? 80.0 : 60.0;
+    return c;
+  };
+  StudyResult r;
+  r.cases = {make(false), make(true)};
+  const std::string t = r.time_markdown();
+  auto count = [&](const std::string& s) {
+    std::size_t n = 0;
+    for (std::size_t p = t.find(s); p != std::string::npos; p = t.find(s, p + 1)) ++n;
+    return n;
+  };
+  EXPECT_EQ(count("| packing C5b hill: servo packing | 1000 | 100000 | 100.0 |"), 1u) << t;
+  EXPECT_EQ(count("| packing C5b hill: cloud relaxation | 1000 | 2000 | 2.0 |"), 1u) << t;
+  EXPECT_EQ(count("| C5b_Hill: finalize C5b_Hill | 1000 | 5000 | 5.0 |"), 1u) << t;
+  EXPECT_EQ(count("| C5b_Hill_wet: finalize C5b_Hill | 1000 | 5000 | 5.0 |"), 1u) << t;
+  EXPECT_EQ(count("| C5b_Hill_wet: wet C5b_Hill | 1000 | 6000 | 6.0 |"), 1u) << t;
+  EXPECT_EQ(count("| C5b_Hill_wet: triaxial test | 1000 | 140000 | 140.0 | 38.0 | 80.0 | 0.571 |"), 1u) << t;
+  // 2,000 + 100,000 + 2 × 5,000 + 6,000 + 110,000 + 140,000 = 368,000 steps of 1,000 grains; 199 s.
+  EXPECT_EQ(count("| all rows | | 368000 | 368.0 | 100.0 | 199.0 | 0.541 |"), 1u) << t;
+  EXPECT_NE(r.summary_markdown().find("Where the time goes"), std::string::npos);
 }
 
 }  // namespace

@@ -257,12 +257,51 @@ std::string StudyResult::summary_markdown() const {
   if (!criterion.empty())
     out += "Packing, finalization and wetting converged when " + criterion +
            "; packing dn: the packing's vessel-porosity change per 1,000 steps at its end.\n";
+  out += "\nWhere the time goes:\n\n" + time_markdown();
   const auto f = findings();
   if (!f.empty()) {
     out += "\nFindings of the memo, checked (a comparison of M_r holds or fails only where the difference exceeds twice its\n"
            "standard error; otherwise it is within noise):\n\n";
     for (const std::string& s : f) out += "* " + s + "\n";
   }
+  return out;
+}
+
+std::string StudyResult::time_markdown() const {
+  struct Row {
+    std::string work;
+    std::size_t grains = 0;
+    std::int64_t steps = 0;
+    double seconds = 0.0;
+  };
+  std::vector<Row> rows;
+  std::vector<std::string> packings_seen;  // a packing shared by several cases is listed once
+  for (const CaseResult& c : cases) {
+    const std::string packing = fmt::format("packing {} {}", c.grading.name, to_string(c.packed_with));
+    const bool first = std::find(packings_seen.begin(), packings_seen.end(), packing) == packings_seen.end();
+    if (first) packings_seen.push_back(packing);
+    for (const PhaseReport& ph : c.phases) {
+      const bool shared = ph.name == "cloud" || ph.name == "packing";
+      if (shared && !first) continue;
+      rows.push_back({shared ? packing + ": " + (ph.name == "cloud" ? "cloud relaxation" : "servo packing") : c.spec.name() + ": " + ph.name,
+                      ph.state.grains, ph.steps, ph.seconds});
+    }
+    rows.push_back({c.spec.name() + ": triaxial test", c.initial.grains, c.test.steps, c.test.seconds});
+  }
+  double total = 0.0, seconds = 0.0;
+  std::int64_t steps = 0;
+  for (const Row& r : rows) total += static_cast<double>(r.grains) * static_cast<double>(r.steps), steps += r.steps, seconds += r.seconds;
+  std::string out = "| work | grains | steps | grain-steps [1e6] | share of grain-steps [%] | wall [s] | wall per 1e6 grain-steps [s] |\n"
+                    "|---|---:|---:|---:|---:|---:|---:|\n";
+  auto per = [](double s, double gs) { return gs > 0 ? fmt::format("{:.3f}", s / (gs / 1e6)) : std::string("n/a"); };
+  for (const Row& r : rows) {
+    const double gs = static_cast<double>(r.grains) * static_cast<double>(r.steps);
+    out += fmt::format("| {} | {} | {} | {:.1f} | {:.1f} | {:.1f} | {} |\n", r.work, r.grains, r.steps, gs / 1e6,
+                       total > 0 ? 100.0 * gs / total : 0.0, r.seconds, per(r.seconds, gs));
+  }
+  out += fmt::format("| all rows | | {} | {:.1f} | 100.0 | {:.1f} | {} |\n", steps, total / 1e6, seconds, per(seconds, total));
+  if (this->seconds > 0)
+    out += fmt::format("\nThe study: {:.1f} s wall clock, {:.1f} s CPU (all threads).\n", this->seconds, cpu_seconds);
   return out;
 }
 

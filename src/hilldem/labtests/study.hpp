@@ -30,12 +30,31 @@ std::vector<CaseSpec> sweep_confinements(const std::vector<CaseSpec>& cases, con
 // The memo's five cases: C5n/C5b × linear/hill, plus C5b hill wet.
 std::vector<CaseSpec> memo_cases();
 
+// The memo's vessel [m] (170 mm × 240 mm, Table 7) and AASHTO T 307's specimen for aggregate base
+// (152 mm × 305 mm, H/D = 2).
+inline constexpr double kMemoVesselRadius = 0.085, kMemoVesselHeight = 0.240;
+inline constexpr double kT307VesselRadius = 0.076, kT307VesselHeight = 0.305;
+// The default study (StudySettings{} and `hilldem triaxial` without --full or --scale): the memo's
+// vessel scaled by kDefaultVesselScale, each grading's scaled up until it holds kDefaultMinGrains
+// grains (C5b stays at 0.5: 1,688 grains; C5n gets 0.83: 498), so that a coarse grading is not a
+// handful of grains across and the five cases run in minutes (docs/lab-tests.md, Defaults).
+inline constexpr double kDefaultVesselScale = 0.5;
+inline constexpr int kDefaultMinGrains = 500;
+// The genesis defaults in the default study's vessel.
+inline GenesisSpec default_study_genesis() {
+  GenesisSpec g;
+  g.vessel_radius = kDefaultVesselScale * kMemoVesselRadius;
+  g.vessel_height = kDefaultVesselScale * kMemoVesselHeight;
+  return g;
+}
+
 struct StudySettings {
-  GenesisSpec genesis;                  // vessel, packing; its grading is replaced by each case's
+  // Vessel, packing; its grading is replaced by each case's. Default: the default study's vessel.
+  GenesisSpec genesis = default_study_genesis();
   // A grading whose expected grain count in genesis's vessel (at the cloud porosity) is below this
   // gets the same vessel shape scaled up until it holds that many (never scaled down); 0: every
   // grading in genesis's vessel. vessel_for says which vessel a grading gets.
-  int min_grains = 0;
+  int min_grains = kDefaultMinGrains;
   Class5Material material;              // Table 7; `model` is replaced by each case's
   WallContact test_walls;               // grain-wall contacts after finalization
   EquilibriumSettings finalize;         // servo equilibrium after finalization and wetting (at P_m)
@@ -85,7 +104,12 @@ struct StudyResult {
   double seconds = 0.0;                 // wall clock [s]
   double cpu_seconds = 0.0;             // process CPU time, all threads [s]
   std::string summary_csv() const;
-  std::string summary_markdown() const;  // the table and the findings
+  std::string summary_markdown() const;  // the table, the findings and time_markdown()
+  // Where the time went: one row per packing (cloud relaxation, servo packing) and per phase of each
+  // case (finalize, wet, confine, triaxial test) with its grains, steps, grain-steps (grains × steps:
+  // a step's cost grows with the grains), share of all grain-steps and wall-clock seconds. With
+  // several jobs at once the seconds of different rows overlap and include the waits for the cores.
+  std::string time_markdown() const;
   std::vector<std::string> findings() const;  // the memo's qualitative claims, each with numbers and a verdict
 };
 
