@@ -23,9 +23,14 @@ build_dir="${1:-build}"
 #   clang, libclang-rt-14-dev, libomp-14-dev
 #                         libFuzzer with AddressSanitizer/UBSan for the fuzz targets (fuzz/, run
 #                         bounded by a test), and OpenMP for that clang build
+#   libopenmpi-dev, openmpi-bin
+#                         MPI for the domain decomposition over ranks (`mpirun -np N hilldem bench`,
+#                         docs/mpi.md): the library and headers, and mpirun
+#   libtrilinos-zoltan-dev
+#                         Zoltan's recursive coordinate bisection: the ranks' sub-domains (docs/mpi.md)
 packages=(g++ cmake make libtomlplusplus-dev libcli11-dev libfmt-dev libgtest-dev
           python3-vtk9 python3-matplotlib pybind11-dev python3-dev python3-numpy python3-pytest
-          clang libclang-rt-14-dev libomp-14-dev)
+          clang libclang-rt-14-dev libomp-14-dev libopenmpi-dev openmpi-bin libtrilinos-zoltan-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -70,7 +75,10 @@ if [ "$use_pgo" != 0 ]; then
   pgo_args=(-DHILLDEM_PGO=use -DHILLDEM_PGO_DIR="$profile")
 fi
 
-cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release "${pgo_args[@]}" >/dev/null
+# The MPI domain decomposition (CMakeLists.txt, HILLDEM_MPI) once OpenMPI and Zoltan are here.
+mpi_args=(-DHILLDEM_MPI=OFF)
+if command -v mpirun >/dev/null && [ -f /usr/include/trilinos/zoltan.h ]; then mpi_args=(-DHILLDEM_MPI=ON); fi
+cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release "${pgo_args[@]}" "${mpi_args[@]}" >/dev/null
 cmake --build "$build_dir" -j"$(nproc)"
 
 # `import hilldem` for Debian's /usr/bin/python3: a hilldem.pth file in its site-packages naming the

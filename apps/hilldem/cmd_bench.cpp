@@ -7,6 +7,10 @@
 #include "hilldem/bench/bed_bench.hpp"
 #include "hilldem/bench/memory_bandwidth.hpp"
 #include "hilldem/core/error.hpp"
+#ifdef HILLDEM_MPI
+#include "hilldem/parallel/bench_mpi.hpp"
+#include "hilldem/parallel/mpi_world.hpp"
+#endif
 
 namespace hilldem::cli {
 
@@ -66,6 +70,13 @@ Command add_bench_command(CLI::App& app) {
               std::cout << "settled in " << steps << " steps: " << *settle_out << std::endl;
               return 0;
             }
+#ifdef HILLDEM_MPI
+            if (const MPI_Comm comm = parallel::world(); comm != MPI_COMM_NULL) {  // under mpirun: decomposed
+              const parallel::DecomposedBenchResult r = parallel::run_bed_bench_mpi(opt, comm);
+              if (!r.halo.empty()) std::cout << r.bench.line() << "\n" << r.halo << std::endl;
+              return 0;
+            }
+#endif
             std::cout << run_bed_bench(opt).line() << std::endl;
             return 0;
           }};

@@ -5,8 +5,35 @@
 
 #include "commands.hpp"
 #include "hilldem/core/error.hpp"
+#ifdef HILLDEM_MPI
+#include "hilldem/parallel/mpi_world.hpp"
+#endif
+
+namespace {
+#ifdef HILLDEM_MPI
+// Under mpirun every rank runs the command; messages come from rank 0 (input errors are the same on
+// every rank: each reads the same files), a run error from the rank that met it, named, and then
+// ends every rank (the others may wait on it in a collective).
+int g_rank = 0, g_size = 1;
+bool quiet_rank() { return g_rank != 0; }
+std::string rank_tag() { return g_size > 1 ? " (rank " + std::to_string(g_rank) + ")" : ""; }
+int run_failed(int status) {
+  if (g_size > 1) MPI_Abort(MPI_COMM_WORLD, status);
+  return status;
+}
+#else
+bool quiet_rank() { return false; }
+std::string rank_tag() { return ""; }
+int run_failed(int status) { return status; }
+#endif
+}  // namespace
 
 int main(int argc, char** argv) {
+#ifdef HILLDEM_MPI
+  hilldem::parallel::MpiSession mpi(argc, argv);
+  g_rank = mpi.rank();
+  g_size = mpi.size();
+#endif
   CLI::App app{"hilldem: discrete-element engine for unsaturated granular materials (PFC 6 hill contact model)"};
   app.require_subcommand(1);
 
@@ -33,19 +60,26 @@ int main(int argc, char** argv) {
 
   try {
     for (const Command& c : commands)
-      if (c.sub && *c.sub) return c.run();
+      if (c.sub && *c.sub) {
+#ifdef HILLDEM_MPI
+        if (g_size > 1 && c.sub->get_name() != "bench")
+          throw hilldem::InputError("'" + c.sub->get_name() + "' does not run decomposed over MPI ranks yet (only "
+                                    "'bench' does, docs/mpi.md): run it without mpirun, or with -np 1");
+#endif
+        return c.run();
+      }
   } catch (const hilldem::InputError& e) {
-    std::cerr << "hilldem: error: " << e.what() << "\n";
+    if (!quiet_rank()) std::cerr << "hilldem: error: " << e.what() << "\n";
     return 2;
   } catch (const hilldem::RunError& e) {
-    std::cerr << "hilldem: run failed: " << e.what() << "\n";
-    return 1;
+    std::cerr << "hilldem: run failed" << rank_tag() << ": " << e.what() << "\n";
+    return run_failed(1);
   } catch (const std::bad_alloc&) {
-    std::cerr << "hilldem: error: out of memory (outside the phases that report their size)\n";
-    return 1;
+    std::cerr << "hilldem: error" << rank_tag() << ": out of memory (outside the phases that report their size)\n";
+    return run_failed(1);
   } catch (const std::exception& e) {
-    std::cerr << "hilldem: error: " << e.what() << "\n";
-    return 1;
+    std::cerr << "hilldem: error" << rank_tag() << ": " << e.what() << "\n";
+    return run_failed(1);
   }
   return 0;
 }

@@ -78,30 +78,37 @@ std::int64_t settle_bed(const std::string& in, const std::string& out, double ra
   return steps;
 }
 
-BedBenchResult run_bed_bench(const BedBenchOptions& o) {
+BedBenchResult run_bed_bench(const BedBenchOptions& o, const BenchDecomposition* dec) {
   if (o.threads > 0) omp_set_num_threads(o.threads);
   Packing packing = read_packing(o.data, PackingFormat::Lammps);
   const int rep[3] = {o.replicate, o.replicate, 1};
   replicate(packing, rep);
   Simulation sim = make_bed(packing);
   if (o.block > 0) sim.balls_per_block = o.block;
+  if (dec) dec->attach(sim);
   sim.cycle(o.warmup);
   const std::int64_t rebuilds0 = sim.rebuilds();
   BedBenchResult r;
-  r.particles = sim.balls.size();
+  r.particles = dec ? dec->particles(sim) : sim.balls.size();
   r.steps = o.steps;
   const double particles = static_cast<double>(r.particles);
+  if (dec) dec->barrier();
   const auto start = std::chrono::steady_clock::now();
   sim.cycle(o.steps);
+  if (dec) dec->barrier();
   r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   r.particle_steps_per_second = particles * static_cast<double>(o.steps) / r.wall_seconds;
   std::size_t ball_contacts = 0;
-  for (std::size_t c = 0; c < sim.contacts.size(); ++c)
-    ball_contacts += sim.contacts.active[c] && sim.contacts.key[c].kind == ContactKind::BallBall;
+  if (dec) {
+    ball_contacts = dec->ball_contacts(sim);
+  } else {
+    for (std::size_t c = 0; c < sim.contacts.size(); ++c)
+      ball_contacts += sim.contacts.active[c] && sim.contacts.key[c].kind == ContactKind::BallBall;
+  }
   r.contacts_per_particle = 2.0 * static_cast<double>(ball_contacts) / static_cast<double>(r.particles);
   r.threads = omp_get_max_threads();
   r.rebuilds = sim.rebuilds() - rebuilds0;
-  if (o.digest) r.digest = state_digest(sim);
+  if (o.digest) r.digest = dec ? dec->digest(sim) : state_digest(sim);
   return r;
 }
 

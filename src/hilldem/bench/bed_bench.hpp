@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -38,9 +39,21 @@ struct BedBenchResult {
   std::string digest;
 };
 
+// What a run decomposed over MPI ranks changes in the bench (parallel/bench_mpi.cpp): the Simulation
+// becomes one rank's part (attach), the clock waits for every rank (barrier), the counts are summed
+// over the ranks, and the digest is that of the whole state.
+struct BenchDecomposition {
+  std::function<void(Simulation&)> attach;
+  std::function<void()> barrier;
+  std::function<std::size_t(const Simulation&)> particles;      // balls owned, summed over the ranks
+  std::function<std::size_t(const Simulation&)> ball_contacts;  // active ball-ball rows, the same
+  std::function<std::string(const Simulation&)> digest;
+};
+
 // The bed as a Simulation, ready to cycle.
 Simulation make_bed(const Packing& packing);
-BedBenchResult run_bed_bench(const BedBenchOptions& options);
+// `decomposition`: null for the whole bed in this process.
+BedBenchResult run_bed_bench(const BedBenchOptions& options, const BenchDecomposition* decomposition = nullptr);
 
 // Settle a bed under hilldem's own contact laws (local damping 0.7, to a mean unbalanced-force
 // ratio of `ratio`) and write it as a LAMMPS data file, so that both codes time the same bed.

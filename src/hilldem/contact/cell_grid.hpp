@@ -4,6 +4,7 @@
 // wrap around; each pair is then found once, with the image of ball j that is closest to ball i.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -19,6 +20,17 @@ struct PeriodicBox {
   Vec3 lo, hi;  // [m]
   bool any() const { return periodic[0] || periodic[1] || periodic[2]; }
   Vec3 length() const { return hi - lo; }
+  // x moved into [lo, hi) along the periodic directions (the neighbour list's wrap at a rebuild).
+  Vec3 wrapped(Vec3 x) const {
+    const Vec3 l = length();
+    for (int d = 0; d < 3; ++d)
+      if (periodic[d]) {
+        x[d] = lo[d] + std::fmod(x[d] - lo[d], l[d]);
+        if (x[d] < lo[d]) x[d] += l[d];
+        if (x[d] >= hi[d]) x[d] -= l[d];
+      }
+    return x;
+  }
 };
 
 // Image of ball j relative to ball i: shifts (−1, 0, +1) per direction packed as

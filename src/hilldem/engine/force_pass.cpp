@@ -174,28 +174,33 @@ void ForcePass::add_wall_rows(std::size_t k0, std::size_t k1) {
   }
 }
 
+void add_wall_row(Wall& w, const ContactStore& contacts, std::size_t c, const Vec3& position, double radius) {
+  const Vec3 point = position + contacts.normal[c] * (radius + 0.5 * contacts.gap[c]);
+  w.force += contacts.force[c];
+  w.moment += cross(point - w.rotation_center, contacts.force[c]) + contacts.moment_state[c];  // (+ M_c: rrlinear)
+  w.normal_force += dot(contacts.force[c], contacts.normal[c]);
+  w.normal_stiffness += wall_normal_stiffness(contacts, c);
+  ++w.active_contacts;
+}
+
+void clear_wall_sums(Wall& w) {
+  w.force = w.moment = Vec3{};
+  w.normal_force = w.normal_stiffness = 0.0;
+  w.active_contacts = 0;
+}
+
 void ForcePass::collect_forces() {
   const ContactStore& contacts = *w_.contacts;
   const BallStore& balls = *w_.balls;
   BallRecords& ball_kin = *w_.kin;
   // The walls' sums, each wall row in row order (the balls' sums were ended by the pass's threads).
   // Rows that are not active contacts hold zero force and moment.
-  for (Wall& w : w_.walls->walls) {
-    w.force = w.moment = Vec3{};
-    w.normal_force = w.normal_stiffness = 0.0;
-    w.active_contacts = 0;
-  }
+  for (Wall& w : w_.walls->walls) clear_wall_sums(w);
   // Each wall row into its wall's sums, in row order.
   for (std::uint32_t c : w_.neighbours->wall_rows()) {
     const ContactKey& k = contacts.key[c];
     if (!contacts.active[c]) continue;
-    Wall& w = w_.walls->walls[k.b];
-    const Vec3 point = ball_kin[k.a].position + contacts.normal[c] * (balls.radius[k.a] + 0.5 * contacts.gap[c]);
-    w.force += contacts.force[c];
-    w.moment += cross(point - w.rotation_center, contacts.force[c]) + contacts.moment_state[c];  // (+ M_c: rrlinear)
-    w.normal_force += dot(contacts.force[c], contacts.normal[c]);
-    w.normal_stiffness += wall_normal_stiffness(contacts, c);
-    ++w.active_contacts;
+    add_wall_row(w_.walls->walls[k.b], contacts, c, ball_kin[k.a].position, balls.radius[k.a]);
   }
   w_.stiffness->ready = want_stiffness();
   // The BallStore's columns of the sums on the passes someone may read them after (as the reported

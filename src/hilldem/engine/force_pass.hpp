@@ -53,6 +53,14 @@ struct PassWorld {
   StiffnessSums* stiffness = nullptr;
 };
 
+// Active row c's share in its wall's sums (force, moment about the wall's rotation centre, normal
+// force and stiffness, active contacts), from the row's results and its ball at `position` [m] of
+// `radius` [m]. A wall's sums are these shares added in row order from zero: the force pass, and the
+// ranks of a domain decomposition over the rows of all ranks (parallel/domain.cpp).
+void add_wall_row(Wall& w, const ContactStore& contacts, std::size_t c, const Vec3& position, double radius);
+// The sums add_wall_row adds to, zeroed.
+void clear_wall_sums(Wall& w);
+
 // How one pass runs.
 struct PassOptions {
   double dt = 0.0;                // Δt [s] of the shear increments (0: forces at the current state)

@@ -26,14 +26,7 @@ void check_finite(const BallStore& balls, std::int64_t step) {
 
 void wrap_positions(BallStore& balls, const PeriodicBox& box) {
   if (!box.any()) return;
-  const Vec3 l = box.length();
-  for (Vec3& x : balls.position)
-    for (int d = 0; d < 3; ++d)
-      if (box.periodic[d]) {
-        x[d] = box.lo[d] + std::fmod(x[d] - box.lo[d], l[d]);
-        if (x[d] < box.lo[d]) x[d] += l[d];
-        if (x[d] >= box.hi[d]) x[d] -= l[d];
-      }
+  for (Vec3& x : balls.position) x = box.wrapped(x);
 }
 
 using Candidates = std::vector<std::pair<ContactKey, ImageCode>>;

@@ -117,6 +117,10 @@ void Simulation::step_body(bool last) {
     neighbours_.add_wall_motion(w, dt);
     advance_wall(w, dt);
   }
+  if (domain) {  // the ghosts' motion is their owners' (the law of motion here had only part of their forces)
+    drop_records();
+    domain->after_motion(*this);
+  }
   rebuild_if_needed();  // step 3
   force_pass(dt);       // steps 3-4
   time += dt;
@@ -176,7 +180,7 @@ void Simulation::advance_records(double dt, const double* inertial_mass, const d
   live_.after_motion(live_list, live, bounded, moved.worst_live, growth);
 }
 
-void Simulation::rebuild_if_needed() {
+bool Simulation::rebuild_due() {
   const bool measured = neighbours_.take_motion_bound();  // by advance_records, this step
   if (!neighbours_.stale(balls.size())) {
     if (ball_kin_.current() && !skin_known_) {  // (the radii stay until the records are dropped)
@@ -187,7 +191,7 @@ void Simulation::rebuild_if_needed() {
     // A pair outside the list was farther than `skin` beyond proximity at the rebuild. The record
     // motion's bound first: the exact travel is at most the bound, so a bound within the limit gives
     // the exact check's answer without a pass over the positions (a NaN bound fails, and goes on).
-    if (measured && neighbours_.holds(neighbours_.travel_bound(), half)) return;
+    if (measured && neighbours_.holds(neighbours_.travel_bound(), half)) return false;
     // The largest travel since the rebuild, exactly, and since the live rows were made, while they are.
     const bool live = live_.has_positions(balls.size());
     const auto [worst, worst_live] =
@@ -195,9 +199,20 @@ void Simulation::rebuild_if_needed() {
     live_.measured(live, worst_live);
     const double ball_travel = std::sqrt(worst);
     neighbours_.set_travel_bound(ball_travel);  // (exact now: the record motion grows it from here)
-    if (neighbours_.holds(ball_travel, half)) return;
+    if (neighbours_.holds(ball_travel, half)) return false;
   }
+  return true;
+}
+
+void Simulation::rebuild_if_needed() {
+  bool due = rebuild_due();
+  if (domain) due = domain->rebuild_anywhere(due);  // (every rank rebuilds at the same step)
+  if (!due) return;
   drop_records();  // the rebuild reads the columns, and wraps the positions into a periodic box
+  if (domain) {
+    if (live_.records_ready()) live_.sync_records(contacts);  // (the rows travel with their history)
+    domain->before_rebuild(*this);
+  }
   rebuild(settings.proximity);
 }
 

@@ -35,6 +35,24 @@
 
 namespace hilldem {
 
+class Simulation;
+
+// One rank's part of a domain decomposition (parallel/domain.hpp, docs/mpi.md): the Simulation then
+// holds the balls this rank owns and the ghost copies of its neighbours' balls near them, in the
+// relative order of the whole run, and calls these at the three points of the cycle where ranks
+// must agree. Null (the default): the Simulation is the whole run.
+class DomainHooks {
+ public:
+  virtual ~DomainHooks() = default;
+  // After the law of motion (the columns hold the state): the ghosts get their owners' motion.
+  virtual void after_motion(Simulation& sim) = 0;
+  // Whether any rank's balls call for a rebuild, given this rank's answer (the same on every rank).
+  virtual bool rebuild_anywhere(bool here) = 0;
+  // Before a rebuild (columns and rows current): balls move to their new owners with their rows,
+  // and the ghosts are made again. May replace every ball and row of `sim`.
+  virtual void before_rebuild(Simulation& sim) = 0;
+};
+
 class Simulation {
  public:
   BallStore balls;
@@ -53,6 +71,8 @@ class Simulation {
   // Called at the start of every cycle with its Δt [s], before the law of motion, with the forces
   // at t: servos and other controllers set wall or ball velocities here.
   std::vector<std::function<void(Simulation&, double)>> controllers;
+  // The domain decomposition this Simulation is one rank's part of, or null (see DomainHooks).
+  DomainHooks* domain = nullptr;
 
   // Run n cycles. The contacts' reported results (ContactStore gap, force, normal_force,
   // moisture_force, trial_shear, active) are those of the last cycle when it returns, and of every
@@ -116,6 +136,8 @@ class Simulation {
   // Rebuild the neighbour list before the next force evaluation (after bodies were added or moved
   // by hand, or the table changed).
   void invalidate_neighbours() { neighbours_.invalidate(); }
+  // The skin [m]: settings.skin, or (0 there) a tenth of the mean diameter.
+  double skin() const;
   // Number of contacts (rows that exist), and of neighbour-list rebuilds so far.
   std::size_t contact_count() const { return contacts.count_existing(); }
   std::int64_t rebuilds() const { return neighbours_.rebuilds(); }
@@ -154,6 +176,7 @@ class Simulation {
   void rebuild(double reach);
   void build_row_lists();  // the neighbour list's row lists, and the force pass's per-row state
   void rebuild_if_needed();
+  bool rebuild_due();  // whether this Simulation's balls or walls call for a rebuild
   // Each existing row's activity and time-step stiffness now (after make_wet, make_dry, new
   // properties), for the next cycle's Δt.
   void refresh_timestep_stiffness();
@@ -172,7 +195,6 @@ class Simulation {
   }
   // Before the force pass: the ball records, the hill parameter sets, the live rows (and records).
   void prepare_pass();
-  double skin() const;
 
   bool forces_ready_ = false;
   bool write_results_ = true;  // this force pass writes the reported columns (step_once)

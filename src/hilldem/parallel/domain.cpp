@@ -1,0 +1,432 @@
+#include "hilldem/parallel/domain.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <iterator>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+
+#include "hilldem/engine/force_pass.hpp"
+
+namespace hilldem::parallel {
+
+namespace {
+
+// Bytes of trivially copyable values, in the order put.
+struct Buffer {
+  std::vector<char> bytes;
+  template <class T>
+  void put(const T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    const std::size_t at = bytes.size();
+    bytes.resize(at + sizeof(T));
+    std::memcpy(bytes.data() + at, &v, sizeof(T));
+  }
+};
+
+struct Reader {
+  const char* p;
+  const char* end;
+  template <class T>
+  T get() {
+    if (p + sizeof(T) > end) throw std::runtime_error("domain exchange: a message ends early");
+    T v;
+    std::memcpy(&v, p, sizeof(T));
+    p += sizeof(T);
+    return v;
+  }
+};
+
+// Ball i of `balls` (every column), with its global index and owner.
+void put_ball(Buffer& out, BallStore& balls, std::size_t i, std::uint32_t global, int owner) {
+  out.put(global);
+  out.put(owner);
+  balls.for_each_column([&](auto& col) { out.put(col[i]); });
+}
+
+void get_ball(Reader& in, BallStore& balls, std::vector<std::uint32_t>& global, std::vector<int>& owner) {
+  global.push_back(in.get<std::uint32_t>());
+  owner.push_back(in.get<int>());
+  balls.for_each_column([&](auto& col) { col.push_back(in.get<typename std::decay_t<decltype(col)>::value_type>()); });
+}
+
+// Row c of `rows` (every column), its key `key` (in global indices).
+void put_row(Buffer& out, ContactStore& rows, std::size_t c, const ContactKey& key) {
+  ContactStore::zip_columns(rows, rows, [&](auto& col, auto&) {
+    using T = typename std::decay_t<decltype(col)>::value_type;
+    if constexpr (std::is_same_v<T, ContactKey>)
+      out.put(key);
+    else
+      out.put(col[c]);
+  });
+}
+
+void get_row(Reader& in, ContactStore& rows) {
+  ContactStore::zip_columns(rows, rows, [&](auto& col, auto&) { col.push_back(in.get<typename std::decay_t<decltype(col)>::value_type>()); });
+}
+
+// Every rank's buffer for every other, exchanged (collective); the bytes from rank q are
+// received[from[q] .. from[q + 1]].
+struct Received {
+  std::vector<char> bytes;
+  std::vector<int> from;
+};
+
+Received all_to_all(MPI_Comm comm, const std::vector<Buffer>& out, std::uint64_t& sent) {
+  const int size = static_cast<int>(out.size());
+  std::vector<int> send_counts(size), recv_counts(size), send_at(size + 1, 0);
+  for (int q = 0; q < size; ++q) {
+    if (out[q].bytes.size() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+      throw std::runtime_error("domain exchange: more than 2 GiB for one rank");
+    send_counts[q] = static_cast<int>(out[q].bytes.size());
+    send_at[q + 1] = send_at[q] + send_counts[q];
+  }
+  std::vector<char> send(static_cast<std::size_t>(send_at[size]));
+  for (int q = 0; q < size; ++q) std::copy(out[q].bytes.begin(), out[q].bytes.end(), send.begin() + send_at[q]);
+  MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, comm);
+  Received r;
+  r.from.assign(size + 1, 0);
+  for (int q = 0; q < size; ++q) r.from[q + 1] = r.from[q] + recv_counts[q];
+  r.bytes.resize(static_cast<std::size_t>(r.from[size]));
+  MPI_Alltoallv(send.data(), send_counts.data(), send_at.data(), MPI_BYTE, r.bytes.data(), recv_counts.data(),
+                r.from.data(), MPI_BYTE, comm);
+  int self = 0;
+  MPI_Comm_rank(comm, &self);
+  sent += static_cast<std::uint64_t>(send_at[size] - send_counts[self]);
+  return r;
+}
+
+// The local index of global index g among the sorted `global`.
+std::uint32_t local_of(const std::vector<std::uint32_t>& global, std::uint32_t g) {
+  const auto it = std::lower_bound(global.begin(), global.end(), g);
+  if (it == global.end() || *it != g) throw std::runtime_error("domain exchange: a row's ball did not arrive");
+  return static_cast<std::uint32_t>(it - global.begin());
+}
+
+// Balls in arrival order made into a store sorted by global index.
+void sort_balls(BallStore& balls, std::vector<std::uint32_t>& global, std::vector<int>& owner) {
+  std::vector<std::uint32_t> order(global.size());
+  std::iota(order.begin(), order.end(), 0u);
+  std::sort(order.begin(), order.end(), [&](std::uint32_t x, std::uint32_t y) { return global[x] < global[y]; });
+  balls.permute(order);  // (rebuilds the user-id index too)
+  std::vector<std::uint32_t> g(global.size());
+  std::vector<int> o(owner.size());
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    g[k] = global[order[k]];
+    o[k] = owner[order[k]];
+  }
+  for (std::size_t k = 1; k < g.size(); ++k)
+    if (g[k] == g[k - 1]) throw std::runtime_error("domain exchange: a ball arrived twice");
+  global = std::move(g);
+  owner = std::move(o);
+}
+
+// Rows in arrival order (keys in global indices) made into a store sorted by key, with keys in the
+// local indices of `global` (or left global: gather).
+ContactStore sort_rows(ContactStore& rows, const std::vector<std::uint32_t>* global) {
+  if (global)
+    for (ContactKey& k : rows.key) {
+      k.a = local_of(*global, k.a);
+      if (k.kind == ContactKind::BallBall) k.b = local_of(*global, k.b);
+    }
+  std::vector<std::size_t> order(rows.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return rows.key[x] < rows.key[y]; });
+  ContactStore sorted;
+  for (std::size_t c : order) sorted.append_row(rows, c);
+  for (std::size_t c = 1; c < sorted.size(); ++c)
+    if (!(sorted.key[c - 1] < sorted.key[c])) throw std::runtime_error("domain exchange: a row arrived twice");
+  return sorted;
+}
+
+}  // namespace
+
+Domain::Domain(MPI_Comm comm, Simulation& sim) : comm_(comm), sim_(&sim) {
+  MPI_Comm_rank(comm_, &rank_);
+  MPI_Comm_size(comm_, &size_);
+  // The skin from the radii (settings.skin 0) would be each rank's own mean: the whole run's instead.
+  skin_given_ = sim.settings.skin;
+  if (sim.settings.skin <= 0.0) sim.settings.skin = sim.skin();
+  rcb_ = std::make_unique<RcbPartition>(comm_);
+  // The first cut, from every rank's share of the whole run's balls (each rank holds them all).
+  {
+    std::vector<Vec3> points;
+    std::vector<double> weights;
+    std::vector<double> rows(sim.balls.size(), 0.0);
+    for (const ContactKey& k : sim.contacts.key) {
+      rows[k.a] += 1.0;
+      if (k.kind == ContactKind::BallBall) rows[k.b] += 1.0;
+    }
+    for (std::size_t i = static_cast<std::size_t>(rank_); i < sim.balls.size(); i += static_cast<std::size_t>(size_)) {
+      points.push_back(sim.settings.box.wrapped(sim.balls.position[i]));
+      weights.push_back(1.0 + rows[i]);
+    }
+    rcb_->cut(points, weights);
+    ++bytes_.repartitions;
+  }
+  set_width(sim);
+  // This rank's balls (owned or ghosts) and the rows between them, in the whole run's order.
+  BallStore balls;
+  ContactStore rows;
+  std::vector<int> ranks;
+  std::vector<bool> here(sim.balls.size(), false);
+  for (std::size_t i = 0; i < sim.balls.size(); ++i) {
+    ranks.clear();
+    ranks_of(sim.balls.position[i], ranks);
+    if (std::find(ranks.begin(), ranks.end(), rank_) == ranks.end()) continue;
+    here[i] = true;
+    Buffer b;
+    put_ball(b, sim.balls, i, static_cast<std::uint32_t>(i), ranks.front());
+    Reader in{b.bytes.data(), b.bytes.data() + b.bytes.size()};
+    get_ball(in, balls, global_, owner_);
+  }
+  for (std::size_t c = 0; c < sim.contacts.size(); ++c) {
+    const ContactKey& k = sim.contacts.key[c];
+    if (!here[k.a] || (k.kind == ContactKind::BallBall && !here[k.b])) continue;
+    Buffer b;
+    put_row(b, sim.contacts, c, k);
+    Reader in{b.bytes.data(), b.bytes.data() + b.bytes.size()};
+    get_row(in, rows);
+  }
+  sort_balls(balls, global_, owner_);  // (in order already: this makes the user-id index)
+  sim.contacts = sort_rows(rows, &global_);
+  sim.balls = std::move(balls);
+  make_lists(sim);
+  sim.domain = this;  // (the list no longer fits the balls: the next force pass detects afresh)
+}
+
+Domain::~Domain() = default;
+
+std::size_t Domain::owned() const {
+  return static_cast<std::size_t>(std::count(owner_.begin(), owner_.end(), rank_));
+}
+
+void Domain::set_width(const Simulation& sim) {
+  double r = 0.0;
+  for (double x : sim.balls.radius) r = std::max(r, x);
+  MPI_Allreduce(MPI_IN_PLACE, &r, 1, MPI_DOUBLE, MPI_MAX, comm_);
+  width_ = sim.settings.proximity + sim.skin() + 2.0 * r;
+}
+
+void Domain::ranks_of(const Vec3& x, std::vector<int>& out) const {
+  const Vec3 w = sim_->settings.box.wrapped(x);
+  const int owner = rcb_->owner(w);
+  out.push_back(owner);
+  rcb_->near(w, width_, sim_->settings.box, owner, out);
+}
+
+void Domain::make_lists(const Simulation& sim) {
+  send_.assign(static_cast<std::size_t>(size_), {});
+  recv_.assign(static_cast<std::size_t>(size_), {});
+  std::vector<int> ranks;
+  for (std::size_t i = 0; i < global_.size(); ++i) {
+    if (owner_[i] != rank_) {
+      recv_[static_cast<std::size_t>(owner_[i])].push_back(static_cast<std::uint32_t>(i));
+      continue;
+    }
+    ranks.clear();
+    ranks_of(sim.balls.position[i], ranks);
+    for (std::size_t k = 1; k < ranks.size(); ++k) send_[static_cast<std::size_t>(ranks[k])].push_back(static_cast<std::uint32_t>(i));
+  }
+}
+
+void Domain::after_motion(Simulation& sim) {
+  // Position, velocity and spin: what the force pass and the next motion read of a ball that can
+  // change within a step (9 doubles a ghost).
+  constexpr int kDoubles = 9;
+  std::vector<std::vector<double>> out(static_cast<std::size_t>(size_)), in(static_cast<std::size_t>(size_));
+  std::vector<MPI_Request> requests;
+  for (int q = 0; q < size_; ++q) {
+    const auto& list = recv_[static_cast<std::size_t>(q)];
+    if (list.empty()) continue;
+    in[q].resize(list.size() * kDoubles);
+    requests.emplace_back();
+    MPI_Irecv(in[q].data(), static_cast<int>(in[q].size()), MPI_DOUBLE, q, 7, comm_, &requests.back());
+  }
+  for (int q = 0; q < size_; ++q) {
+    const auto& list = send_[static_cast<std::size_t>(q)];
+    if (list.empty()) continue;
+    std::vector<double>& o = out[q];
+    o.reserve(list.size() * kDoubles);
+    for (std::uint32_t i : list)
+      for (const Vec3* v : {&sim.balls.position[i], &sim.balls.velocity[i], &sim.balls.spin[i]}) {
+        o.push_back(v->x);
+        o.push_back(v->y);
+        o.push_back(v->z);
+      }
+    requests.emplace_back();
+    MPI_Isend(o.data(), static_cast<int>(o.size()), MPI_DOUBLE, q, 7, comm_, &requests.back());
+    bytes_.ghost += o.size() * sizeof(double);
+  }
+  MPI_Waitall(static_cast<int>(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
+  for (int q = 0; q < size_; ++q) {
+    const double* p = in[q].data();
+    for (std::uint32_t i : recv_[static_cast<std::size_t>(q)])
+      for (Vec3* v : {&sim.balls.position[i], &sim.balls.velocity[i], &sim.balls.spin[i]}) {
+        *v = {p[0], p[1], p[2]};
+        p += 3;
+      }
+  }
+  ++bytes_.steps;
+}
+
+bool Domain::rebuild_anywhere(bool here) {
+  int any = here ? 1 : 0;
+  MPI_Allreduce(MPI_IN_PLACE, &any, 1, MPI_INT, MPI_LOR, comm_);
+  return any != 0;
+}
+
+void Domain::before_rebuild(Simulation& sim) {
+  const std::size_t n = sim.balls.size();
+  ContactStore& rows = sim.contacts;
+  // Rows per owned ball (integers: the sums are exact in any order); a new cut when out of balance.
+  std::vector<double> load(n, 1.0);
+  for (const ContactKey& k : rows.key) {
+    load[k.a] += 1.0;
+    if (k.kind == ContactKind::BallBall) load[k.b] += 1.0;
+  }
+  long long mine = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (owner_[i] == rank_) mine += static_cast<long long>(load[i]);
+  long long most = mine, all = mine;
+  MPI_Allreduce(MPI_IN_PLACE, &most, 1, MPI_LONG_LONG, MPI_MAX, comm_);
+  MPI_Allreduce(MPI_IN_PLACE, &all, 1, MPI_LONG_LONG, MPI_SUM, comm_);
+  if (size_ > 1 && static_cast<double>(most) > kImbalance * static_cast<double>(all) / size_) {
+    std::vector<Vec3> points;
+    std::vector<double> weights;
+    for (std::size_t i = 0; i < n; ++i)
+      if (owner_[i] == rank_) {
+        points.push_back(sim.settings.box.wrapped(sim.balls.position[i]));
+        weights.push_back(load[i]);
+      }
+    rcb_->cut(points, weights);
+    ++bytes_.repartitions;
+  }
+  set_width(sim);
+  // Where each local ball is to be: its new owner, then its ghost ranks (sorted after the first).
+  std::vector<std::vector<int>> where(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    ranks_of(sim.balls.position[i], where[i]);
+    std::sort(where[i].begin() + 1, where[i].end());
+  }
+  std::vector<Buffer> out(static_cast<std::size_t>(size_));
+  // Balls from their old owner to every rank that is to hold them; rows from the old owner of their
+  // first ball to every rank that is to hold both balls. Balls first, then a marker, then rows.
+  std::vector<std::vector<std::uint32_t>> row_lists(static_cast<std::size_t>(size_));
+  for (std::size_t i = 0; i < n; ++i) {
+    if (owner_[i] != rank_) continue;
+    for (int q : where[i]) put_ball(out[static_cast<std::size_t>(q)], sim.balls, i, global_[i], where[i].front());
+  }
+  std::vector<int> both;
+  auto sorted = [](std::vector<int> v) {
+    std::sort(v.begin(), v.end());
+    return v;
+  };
+  for (std::size_t c = 0; c < rows.size(); ++c) {
+    const ContactKey& k = rows.key[c];
+    if (owner_[k.a] != rank_) continue;
+    both.clear();
+    if (k.kind == ContactKind::BallBall) {
+      const std::vector<int> wa = sorted(where[k.a]), wb = sorted(where[k.b]);
+      std::set_intersection(wa.begin(), wa.end(), wb.begin(), wb.end(), std::back_inserter(both));
+    } else {
+      both = where[k.a];
+    }
+    for (int q : both) row_lists[static_cast<std::size_t>(q)].push_back(static_cast<std::uint32_t>(c));
+  }
+  for (int q = 0; q < size_; ++q) {
+    Buffer& b = out[static_cast<std::size_t>(q)];
+    b.put(std::uint32_t{UINT32_MAX});  // (no global index is this: the end of the balls)
+    for (std::uint32_t c : row_lists[static_cast<std::size_t>(q)]) {
+      ContactKey g = rows.key[c];
+      g.a = global_[g.a];
+      if (g.kind == ContactKind::BallBall) g.b = global_[g.b];
+      put_row(b, rows, c, g);
+    }
+  }
+  const Received got = all_to_all(comm_, out, bytes_.migration);
+  BallStore balls;
+  ContactStore arrived;
+  std::vector<std::uint32_t> global;
+  std::vector<int> owner;
+  for (int q = 0; q < size_; ++q) {
+    Reader in{got.bytes.data() + got.from[q], got.bytes.data() + got.from[q + 1]};
+    while (true) {
+      Reader peek = in;
+      if (peek.get<std::uint32_t>() == UINT32_MAX) {
+        in = peek;
+        break;
+      }
+      get_ball(in, balls, global, owner);
+    }
+    while (in.p < in.end) get_row(in, arrived);
+  }
+  sort_balls(balls, global, owner);
+  sim.contacts = sort_rows(arrived, &global);
+  sim.balls = std::move(balls);
+  global_ = std::move(global);
+  owner_ = std::move(owner);
+  make_lists(sim);
+  ++bytes_.rebuilds;
+}
+
+Simulation Domain::gather() const {
+  const Simulation& sim = *sim_;
+  Buffer b;
+  auto& balls = const_cast<BallStore&>(sim.balls);  // (for_each_column is non-const; only read)
+  auto& rows = const_cast<ContactStore&>(sim.contacts);
+  std::uint32_t n_owned = 0;
+  for (std::size_t i = 0; i < global_.size(); ++i) n_owned += owner_[i] == rank_;
+  b.put(n_owned);
+  for (std::size_t i = 0; i < global_.size(); ++i)
+    if (owner_[i] == rank_) put_ball(b, balls, i, global_[i], rank_);
+  for (std::size_t c = 0; c < rows.size(); ++c) {
+    ContactKey g = rows.key[c];
+    if (owner_[g.a] != rank_) continue;
+    g.a = global_[g.a];
+    if (g.kind == ContactKind::BallBall) g.b = global_[g.b];
+    put_row(b, rows, c, g);
+  }
+  int count = static_cast<int>(b.bytes.size());
+  std::vector<int> counts(static_cast<std::size_t>(size_)), at(static_cast<std::size_t>(size_) + 1, 0);
+  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm_);
+  for (int q = 0; q < size_; ++q) at[q + 1] = at[q] + counts[q];
+  std::vector<char> all(rank_ == 0 ? static_cast<std::size_t>(at[size_]) : 0);
+  MPI_Gatherv(b.bytes.data(), count, MPI_BYTE, all.data(), counts.data(), at.data(), MPI_BYTE, 0, comm_);
+  Simulation whole;
+  if (rank_ != 0) return whole;
+  whole.settings = sim.settings;
+  whole.settings.skin = skin_given_;
+  whole.table = sim.table;
+  whole.groups = sim.groups;
+  whole.walls = sim.walls;
+  whole.time = sim.time;
+  whole.steps = sim.steps;
+  whole.last_dt = sim.last_dt;
+  std::vector<std::uint32_t> global;
+  std::vector<int> owner;
+  ContactStore arrived;
+  for (int q = 0; q < size_; ++q) {
+    Reader in{all.data() + at[q], all.data() + at[q + 1]};
+    const auto balls_here = in.get<std::uint32_t>();
+    for (std::uint32_t k = 0; k < balls_here; ++k) get_ball(in, whole.balls, global, owner);
+    while (in.p < in.end) get_row(in, arrived);
+  }
+  sort_balls(whole.balls, global, owner);
+  for (std::size_t k = 0; k < global.size(); ++k)
+    if (global[k] != k) throw std::runtime_error("domain gather: ball " + std::to_string(k) + " is missing");
+  whole.contacts = sort_rows(arrived, nullptr);
+  // The walls' sums as the whole run's force pass makes them: every active wall row, in row order.
+  for (Wall& w : whole.walls.walls) clear_wall_sums(w);
+  for (std::size_t c = 0; c < whole.contacts.size(); ++c) {
+    const ContactKey& k = whole.contacts.key[c];
+    if (k.kind != ContactKind::BallWall || !whole.contacts.active[c]) continue;
+    add_wall_row(whole.walls.walls[k.b], whole.contacts, c, whole.balls.position[k.a], whole.balls.radius[k.a]);
+  }
+  return whole;
+}
+
+}  // namespace hilldem::parallel

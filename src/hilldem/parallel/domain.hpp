@@ -1,0 +1,91 @@
+// Domain: one rank's part of a run decomposed over MPI ranks (docs/mpi.md).
+//
+// The rank's Simulation holds the balls whose centres lie in its sub-domain (owned) and ghost
+// copies of every ball within `ghost_width()` of it, all in the relative order of the whole run
+// (by global index: a ball's index in the whole run's BallStore). The engine sums each ball's rows
+// in one order by local index (engine/force_pass.hpp), and local order is global order, so each
+// owned ball sees the same rows, with the same inputs, in the same order as in the whole run: the
+// same bits for any rank count. Every row between two local balls is kept, ghost-ghost rows too, and
+// is bitwise the whole run's row: its inputs are exact copies.
+//
+// Per step (DomainHooks): after the law of motion each owner sends its balls' position, velocity and
+// spin to the ranks that ghost them (after_motion); the rebuild decision is the OR of the ranks'
+// (rebuild_anywhere); before a rebuild (before_rebuild) the balls go to their new owner and ghost
+// ranks with every column, and each row goes from the owner of its first ball to every rank that
+// will hold both its balls, with its history (the pattern of LAMMPS's fix neigh/history). The
+// sub-domains are cut again by Zoltan RCB, weighted by rows per ball, when the rows per rank are out
+// of balance by more than kImbalance.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <mpi.h>
+
+#include "hilldem/engine/simulation.hpp"
+#include "hilldem/parallel/partition.hpp"
+
+namespace hilldem::parallel {
+
+// Bytes this rank sent, for docs/mpi.md's halo volume.
+struct ExchangeBytes {
+  std::uint64_t ghost = 0;      // after_motion: ghosts' motion
+  std::uint64_t migration = 0;  // before_rebuild: balls and rows
+  std::int64_t steps = 0, rebuilds = 0, repartitions = 0;
+};
+
+class Domain final : public DomainHooks {
+ public:
+  // Rebalance when the largest rank's rows exceed the mean by this factor [-].
+  static constexpr double kImbalance = 1.10;
+
+  // Make `sim`, the whole run (the same on every rank: balls, walls, rows), this rank's part, and
+  // attach to it (sim.domain). sim must stay where it is while attached; a Simulation that outlives
+  // its Domain is detached by setting sim.domain = nullptr (the destructor does not touch sim).
+  Domain(MPI_Comm comm, Simulation& sim);
+  ~Domain() override;
+  Domain(const Domain&) = delete;
+  Domain& operator=(const Domain&) = delete;
+
+  void after_motion(Simulation& sim) override;
+  bool rebuild_anywhere(bool here) override;
+  void before_rebuild(Simulation& sim) override;
+
+  // The whole run's state on rank 0 (balls by global index, rows by key in global indices, the walls'
+  // sums over all rows in row order); an empty Simulation on other ranks. Collective.
+  Simulation gather() const;
+
+  int rank() const { return rank_; }
+  int size() const { return size_; }
+  std::size_t owned() const;  // balls owned here
+  bool owns(std::size_t local) const { return owner_[local] == rank_; }
+  // The global index of local ball i.
+  std::uint32_t global_index(std::size_t local) const { return global_[local]; }
+  std::size_t ghosts() const { return global_.size() - owned(); }
+  // The ghost layer's width [m]: reach (proximity + skin) + twice the largest radius.
+  double ghost_width() const { return width_; }
+  const ExchangeBytes& bytes() const { return bytes_; }
+
+ private:
+  MPI_Comm comm_;
+  int rank_ = 0, size_ = 1;
+  Simulation* sim_;
+  double skin_given_ = 0.0;          // the scenario's skin (0: from the radii, fixed at the attach)
+  std::unique_ptr<RcbPartition> rcb_;
+  double width_ = 0.0;               // [m]
+  std::vector<std::uint32_t> global_;  // per local ball: its global index (ascending)
+  std::vector<int> owner_;             // per local ball: its owner's rank
+  // after_motion's lists: per rank, the local balls sent (owned here, ghosted there) and received.
+  std::vector<std::vector<std::uint32_t>> send_, recv_;
+  ExchangeBytes bytes_;
+
+  void set_width(const Simulation& sim);
+  void cut(const Simulation& sim, bool weighted);
+  // Every rank that is to hold the ball at x [m] (position as in the columns): its owner first, then
+  // its ghost ranks, sorted.
+  void ranks_of(const Vec3& x, std::vector<int>& out) const;
+  void make_lists(const Simulation& sim);
+};
+
+}  // namespace hilldem::parallel
