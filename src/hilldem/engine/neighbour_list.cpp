@@ -5,6 +5,7 @@
 #include <limits>
 #include <string>
 
+#include "hilldem/bodies/clump_pebbles.hpp"
 #include "hilldem/core/error.hpp"
 
 namespace hilldem {
@@ -38,11 +39,16 @@ void wrap_positions(BallStore& balls, const PeriodicBox& box) {
 
 // The candidate pairs within reach [m], sorted by key (ball-ball with their periodic image).
 std::vector<std::pair<ContactKey, ImageCode>> candidates(const BallStore& balls, const WallStore& walls,
-                                                         const PeriodicBox& box, double reach) {
+                                                         const PeriodicBox& box, double reach,
+                                                         const std::vector<std::uint32_t>& clump_of) {
   std::vector<PairCandidate> pairs = find_pair_candidates(balls.position, balls.radius, reach, box);
   std::vector<std::pair<ContactKey, ImageCode>> all;
   all.reserve(pairs.size());
-  for (const PairCandidate& p : pairs) all.push_back({{p.i, ContactKind::BallBall, p.j}, p.image});
+  const bool clumps = !clump_of.empty();
+  for (const PairCandidate& p : pairs) {
+    if (clumps && clump_of[p.i] != kNoClump && clump_of[p.i] == clump_of[p.j]) continue;  // one rigid body
+    all.push_back({{p.i, ContactKind::BallBall, p.j}, p.image});
+  }
   for (std::uint32_t w = 0; w < walls.size(); ++w)
     for (std::uint32_t i = 0; i < balls.size(); ++i) {
       const auto touch = wall_touch(walls.walls[w], balls.position[i], balls.radius[i]);
@@ -54,10 +60,11 @@ std::vector<std::pair<ContactKey, ImageCode>> candidates(const BallStore& balls,
 }  // namespace
 
 void NeighbourList::rebuild(ContactStore& contacts, BallStore& balls, const WallStore& walls, const ModelTable& table,
-                            const PeriodicBox& box, double reach, std::int64_t step, const MapRow& map_row) {
+                            const PeriodicBox& box, double reach, std::int64_t step, const MapRow& map_row,
+                            const std::vector<std::uint32_t>& clump_of) {
   check_finite(balls, step);  // (before the wrap: the message gives the position the run reached)
   wrap_positions(balls, box);
-  const std::vector<std::pair<ContactKey, ImageCode>> all = candidates(balls, walls, box, reach);
+  const std::vector<std::pair<ContactKey, ImageCode>> all = candidates(balls, walls, box, reach, clump_of);
   // Merge with the existing rows (also sorted): history survives.
   ContactStore next;
   next.key.reserve(all.size());

@@ -38,9 +38,11 @@ class NeighbourList {
   // §2.5). A new row takes its assignment rule's model and parameters (`table`); pairs no rule
   // matches are counted (unassigned_pairs). Positions are wrapped into the periodic box first.
   // Throws RunError for a ball with a non-finite position (`step`: for the message). The row lists
-  // are left to build_row_lists; built() ends the rebuild.
+  // are left to build_row_lists; built() ends the rebuild. clump_of: per ball its clump
+  // (ClumpBodies::clump_of_balls), empty without clumps: no rows between pebbles of one clump.
   void rebuild(ContactStore& contacts, BallStore& balls, const WallStore& walls, const ModelTable& table,
-               const PeriodicBox& box, double reach, std::int64_t step, const MapRow& map_row);
+               const PeriodicBox& box, double reach, std::int64_t step, const MapRow& map_row,
+               const std::vector<std::uint32_t>& clump_of = {});
   // The per-ball row lists of `n` balls from the current rows (in row order).
   void build_row_lists(const ContactStore& contacts, std::size_t n);
   // The rebuild is done at these positions [m]: the travel since counts from here.
