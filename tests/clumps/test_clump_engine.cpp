@@ -22,19 +22,25 @@ using testing::linear_wall_rule;
 
 constexpr double kR = 5e-3;  // [m]
 
-// Two balls on a floor plane, under gravity and local damping, with the hill model between grains
-// and the linear model on the wall; auto Δt.
-Simulation two_ball_floor() {
+// A floor plane at z = 0 under gravity and local damping α, with the hill model (μ 0.4, damping
+// constant γ) between grains and the linear model on the wall.
+Simulation floor_scene(double alpha, double gamma) {
   Simulation sim;
-  sim.balls.add(granite(1, {0, 0, 5.1e-3}, kR));
-  sim.balls.add(granite(2, {10.3e-3, 0.4e-3, 5.2e-3}, kR, {0, 0.05, 0}));
   Wall floor;
   floor.name = "floor";
   sim.walls.add(floor);
-  sim.table.rules.push_back(hill_rule(0.4, 0.07));
+  sim.table.rules.push_back(hill_rule(0.4, gamma));
   sim.table.rules.push_back(linear_wall_rule(29e6, 0.4));
   sim.settings.gravity = {0, 0, -9.81};
-  sim.settings.local_damping = 0.3;
+  sim.settings.local_damping = alpha;
+  return sim;
+}
+
+// Two balls on the floor; auto Δt.
+Simulation two_ball_floor() {
+  Simulation sim = floor_scene(0.3, 0.07);
+  sim.balls.add(granite(1, {0, 0, 5.1e-3}, kR));
+  sim.balls.add(granite(2, {10.3e-3, 0.4e-3, 5.2e-3}, kR, {0, 0.05, 0}));
   sim.settings.timestep_max = 1e-6;  // (the automatic Δt before the first contact)
   return sim;
 }
@@ -109,15 +115,7 @@ ClumpTemplate rod() {
 }
 
 Simulation rod_on_floor(double damping) {
-  Simulation sim;
-  Wall floor;
-  floor.name = "floor";
-  sim.walls.add(floor);
-  ModelRule wall = linear_wall_rule(29e6, 0.4);
-  sim.table.rules.push_back(hill_rule(0.4, 0.2));
-  sim.table.rules.push_back(wall);
-  sim.settings.gravity = {0, 0, -9.81};
-  sim.settings.local_damping = damping;
+  Simulation sim = floor_scene(damping, 0.2);
   ClumpInit c = init_at(1, {0, 0, 6e-3});
   c.orientation = normalized(Quat{1.0, 0.1, 0.15, 0.05});  // tilted: it lands on one end first
   sim.clumps.add(sim.balls, rod(), c);
@@ -193,14 +191,7 @@ TEST(ClumpEngine, CollidingClumpsConserveMomentum) {
 
 // A bed of clumps and balls in a box: falls and collides (used by the restart and thread tests).
 Simulation clump_bed() {
-  Simulation sim;
-  Wall floor;
-  floor.name = "floor";
-  sim.walls.add(floor);
-  sim.table.rules.push_back(hill_rule(0.4, 0.1));
-  sim.table.rules.push_back(linear_wall_rule(29e6, 0.4));
-  sim.settings.gravity = {0, 0, -9.81};
-  sim.settings.local_damping = 0.5;
+  Simulation sim = floor_scene(0.5, 0.1);
   sim.settings.auto_timestep = false;  // (the automatic Δt before the first contact is timestep_max)
   sim.settings.timestep = 4e-6;
   std::int64_t id = 1;

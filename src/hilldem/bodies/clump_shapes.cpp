@@ -49,7 +49,9 @@ Pebbles fill_ellipsoid(const EllipsoidFill& f) {
 
 ClumpTemplate named_template(const std::string& name, double density) {
   Pebbles p;
-  if (name == "elongated2") {
+  if (name == "sphere") {
+    p.position = {{0.0, 0.0, 0.0}};
+  } else if (name == "elongated2") {
     p.position = {{-0.5, 0.0, 0.0}, {0.5, 0.0, 0.0}};
   } else if (name == "elongated3") {
     p.position = {{-1.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}};

@@ -25,12 +25,13 @@ struct EllipsoidFill {
 Pebbles fill_ellipsoid(const EllipsoidFill& f);
 
 // Named templates for the command line (bench --clumps, docs/clumps.md), in units of the pebble
-// radius (scale them with ClumpTemplate::scaled): "elongated2", two equal pebbles of radius 1 with
+// radius (scale them with ClumpTemplate::scaled): "sphere", one pebble of radius 1 (a clump that is
+// a ball: for comparing the two paths on one geometry); "elongated2", two equal pebbles of radius 1 with
 // centres 1 apart (length 3, width 2: aspect ratio 1.5); "elongated3", three equal pebbles in a row,
-// centres 1 apart (length 4: aspect ratio 2). Mass properties for density ρ [kg/m³] (elongated2 exact,
-// elongated3 by columns at the default n). Throws InputError naming the known names.
+// centres 1 apart (length 4: aspect ratio 2). Mass properties for density ρ [kg/m³] (sphere and elongated2
+// exact, elongated3 by columns at the default n). Throws InputError naming the known names.
 ClumpTemplate named_template(const std::string& name, double density);
-inline constexpr const char* kNamedTemplates = "elongated2, elongated3";
+inline constexpr const char* kNamedTemplates = "sphere, elongated2, elongated3";
 
 // The volume (4/3)π a b c [m³] of the ellipsoid.
 double ellipsoid_volume(const EllipsoidFill& f);
