@@ -52,7 +52,14 @@ ClumpTemplate read_clump_template_shape(TableReader& t, double density) {
   } catch (const InputError& e) {
     t.fail(listed ? "radii" : "ellipsoid", e.what());
   }
-  if (t.has("size")) tmpl = tmpl.scaled(t.real("size", std::nullopt, Range::open(0.0, 1e3), "[m] (equal-volume diameter)"));
+  if (t.has("size")) {
+    const double size = t.real("size", std::nullopt, Range::open(0.0, 1e3), "[m] (equal-volume diameter)");
+    try {
+      tmpl = tmpl.scaled(size);
+    } catch (const InputError& e) {
+      t.fail("size", e.what());  // (a template too small for its scale factor to be finite)
+    }
+  }
   return tmpl;
 }
 
