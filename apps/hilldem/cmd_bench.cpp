@@ -6,6 +6,7 @@
 #include "commands.hpp"
 #include "hilldem/bench/bed_bench.hpp"
 #include "hilldem/bench/memory_bandwidth.hpp"
+#include "hilldem/bodies/clump_shapes.hpp"
 #include "hilldem/core/error.hpp"
 #ifdef HILLDEM_MPI
 #include "hilldem/parallel/bench_mpi.hpp"
@@ -42,6 +43,9 @@ Command add_bench_command(CLI::App& app) {
                   "instead of timing the bed: what one core sees at working sets from 256 KiB to 256 MiB, one line "
                   "each: a streaming read-modify-write in GB/s and the latency of a load at a random line in ns "
                   "(why a bed whose step data fit in the caches runs faster per particle; docs/performance.md)");
+  bench->add_option("--clumps", o->clumps,
+                    std::string("each sphere a clump of this template (") + kNamedTemplates +
+                        "), as large as the sphere, randomly oriented; the box not periodic (docs/clumps.md)");
   bench->add_option("--settle", *settle_out,
                     "instead of timing: settle the --data bed under hilldem's laws and write it to this file");
   return {bench, [o, settle_out, memory, caches] {

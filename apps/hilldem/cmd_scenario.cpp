@@ -69,8 +69,12 @@ std::vector<Command> add_scenario_commands(CLI::App& app) {
   out.push_back({check, [o] {
                    const ScenarioDescription sc = read_scenario_file(o->file);  // read and validated, not built
                    check_output_folder(o->file, sc.output_dir, *o);
-                   std::cout << fmt::format("{}: valid ({} balls, {} walls, {} assignment rules, {} stages, {} histories)\n",
-                                            o->file, sc.sim.balls.size(), sc.sim.walls.size(),
+                   std::size_t pebbles = 0;
+                   for (const auto& c : sc.sim.clumps) pebbles += sc.sim.clump_templates[c.tmpl].pebbles.size();
+                   const std::string clumps =
+                       sc.sim.clumps.empty() ? "" : fmt::format("{} clumps of {} pebbles, ", sc.sim.clumps.size(), pebbles);
+                   std::cout << fmt::format("{}: valid ({} balls, {}{} walls, {} assignment rules, {} stages, {} histories)\n",
+                                            o->file, sc.sim.balls.size(), clumps, sc.sim.walls.size(),
                                             sc.sim.rules.size(), sc.stages.size(), sc.histories.size());
                    return 0;
                  }});

@@ -6,6 +6,8 @@ add_executable(hilldem_clump_tests
   clumps/test_rigid_body.cpp
   clumps/test_clump_shapes.cpp
   clumps/test_clump_pebbles.cpp
+  clumps/test_clump_engine.cpp
+  clumps/test_clump_scenario.cpp
 )
 target_link_libraries(hilldem_clump_tests PRIVATE hilldem::core GTest::gtest_main)
 target_compile_options(hilldem_clump_tests PRIVATE -Wall -Wextra -Wpedantic)

@@ -77,7 +77,7 @@ def run(scenario, out, *extra):
 
 
 BALL_FIELDS = {"id": 1, "radius": 1, "mass": 1, "velocity": 3, "spin": 3, "contact_force": 3, "contact_moment": 3,
-               "fixity": 1, "groups": 1, "group": 1, "coordination": 1, "wet_contacts": 1, "moisture_force": 1}
+               "fixity": 1, "groups": 1, "group": 1, "coordination": 1, "wet_contacts": 1, "moisture_force": 1, "clump_id": 1}
 CONTACT_FIELDS = {"ball1": 1, "ball2": 1, "wall": 1, "kind": 1, "model": 1, "mois_state": 1, "wet": 1, "active": 1,
                   "gap": 1, "normal": 3, "normal_force": 1, "moisture_force": 1, "shear_force": 3, "shear_force_mag": 1,
                   "force": 3, "contact_point": 3, "suction": 1}
@@ -154,11 +154,28 @@ def wet_bed():
     check(wb.sum() == 2 * wet.sum(), "per-ball wet counts do not add up to twice the wet contacts")
 
 
+def clumps_box():
+    """examples/clumps_box.toml: 7 clumps of 3 pebbles; each pebble is a point with its clump's index."""
+    snaps = run(source / "examples/clumps_box.toml", work / "clumps", "--snapshots-every", "20000")
+    final_b = read(series(snaps, "balls")[-1][1])
+    check(final_b.GetNumberOfPoints() == 21, f"clumps: {final_b.GetNumberOfPoints()} pebbles, expected 21")
+    cid = array(final_b.GetPointData(), "clump_id")
+    check(sorted(cid.tolist()) == [k for k in range(7) for _ in range(3)], f"clumps: clump_id {cid.tolist()}")
+    ids = array(final_b.GetPointData(), "id")
+    check(all(cid[i] == (ids[i] - 1) // 3 for i in range(21)), "clumps: pebbles 3k+1..3k+3 are clump k's")
+    # At rest in the box: every pebble above the floor by less than the box is high, none outside.
+    pts = vtk_to_numpy(final_b.GetPoints().GetData())
+    check((abs(pts[:, 0]) < 18e-3).all() and (abs(pts[:, 1]) < 18e-3).all() and (pts[:, 2] > 0).all(),
+          "clumps: a pebble outside the box")
+    check(pts[:, 2].max() < 20e-3, f"clumps: not settled (highest pebble at z = {pts[:, 2].max()} m)")
+
+
 b_bin, c_bin = assembly("binary")
 b_asc, c_asc = assembly("ascii")
 same(b_bin, b_asc, "balls")
 same(c_bin, c_asc, "contacts")
 wet_bed()
+clumps_box()
 if failures:
     print(f"{len(failures)} failures")
     sys.exit(1)

@@ -1,9 +1,13 @@
 #include "hilldem/bench/bed_bench.hpp"
 
 #include <chrono>
+#include <cmath>
+#include <numbers>
+#include <random>
 #include <fmt/format.h>
 #include <omp.h>
 
+#include "hilldem/bodies/clump_shapes.hpp"
 #include "hilldem/core/error.hpp"
 #include "hilldem/io/state_io.hpp"
 
@@ -15,9 +19,10 @@ namespace hilldem {
 
 std::string BedBenchResult::line() const {
   return fmt::format("particles={} steps={} wall_s={:.3f} particle_steps_per_s={:.4g} contacts_per_particle={:.3f} "
-                     "threads={} rebuilds={} build={}{}",
+                     "threads={} rebuilds={} build={}{}{}",
                      particles, steps, wall_seconds, particle_steps_per_second, contacts_per_particle, threads, rebuilds,
-                     HILLDEM_BUILD_KIND, digest.empty() ? "" : " digest=" + digest);
+                     HILLDEM_BUILD_KIND, clumps > 0 ? fmt::format(" clumps={}", clumps) : "",
+                     digest.empty() ? "" : " digest=" + digest);
 }
 
 Simulation make_bed(const Packing& packing) {
@@ -63,6 +68,36 @@ Simulation make_bed(const Packing& packing) {
   return sim;
 }
 
+Simulation make_clump_bed(const Packing& packing, const ClumpTemplate& unit, std::uint64_t seed) {
+  const Simulation spheres = make_bed(packing);  // (in its spatial order: clumps, and so pebbles, follow it)
+  Simulation sim;
+  sim.settings = spheres.settings;
+  sim.settings.box = PeriodicBox{};
+  sim.table = spheres.table;
+  sim.walls = spheres.walls;
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::int64_t id = 1;
+  for (std::size_t i = 0; i < spheres.balls.size(); ++i) {
+    // A uniformly random rotation (Shoemake, Graphics Gems III, 1992).
+    const double u1 = u(rng), u2 = 2.0 * std::numbers::pi * u(rng), u3 = 2.0 * std::numbers::pi * u(rng);
+    const Quat q{std::sqrt(1.0 - u1) * std::sin(u2), std::sqrt(1.0 - u1) * std::cos(u2), std::sqrt(u1) * std::sin(u3),
+                 std::sqrt(u1) * std::cos(u3)};
+    ClumpInit c;
+    c.first_ball_id = id;
+    c.position = spheres.balls.position[i];
+    c.orientation = normalized(q);
+    c.young_mod = spheres.balls.young_mod[i];
+    c.pois_ratio = spheres.balls.pois_ratio[i];
+    const ClumpTemplate t = unit.scaled(2.0 * spheres.balls.radius[i], SizeMeasure::EnclosingDiameter);
+    // (about the template's centre of mass: the pebbles stay inside the sphere, whose centre it is)
+    sim.clumps.add(sim.balls, t, c);
+    id += static_cast<std::int64_t>(t.pebbles.size());
+  }
+  sim.invalidate_forces();
+  return sim;
+}
+
 std::int64_t settle_bed(const std::string& in, const std::string& out, double ratio) {
   Packing packing = read_packing(in, PackingFormat::Lammps);
   Simulation sim = make_bed(packing);
@@ -83,13 +118,17 @@ BedBenchResult run_bed_bench(const BedBenchOptions& o, const BenchDecomposition*
   Packing packing = read_packing(o.data, PackingFormat::Lammps);
   const int rep[3] = {o.replicate, o.replicate, 1};
   replicate(packing, rep);
-  Simulation sim = make_bed(packing);
+  if (dec && !o.clumps.empty())
+    throw InputError("bench --clumps: clumps are not decomposed over MPI ranks yet (docs/mpi.md); run it on one rank");
+  Simulation sim = o.clumps.empty() ? make_bed(packing)
+                                    : make_clump_bed(packing, named_template(o.clumps, 2650.0), 10000);
   if (o.block > 0) sim.balls_per_block = o.block;
   if (dec) dec->attach(sim);
   sim.cycle(o.warmup);
   const std::int64_t rebuilds0 = sim.rebuilds();
   BedBenchResult r;
   r.particles = dec ? dec->particles(sim) : sim.balls.size();
+  r.clumps = sim.clumps.size();
   r.steps = o.steps;
   const double particles = static_cast<double>(r.particles);
   if (dec) dec->barrier();

@@ -23,10 +23,16 @@ struct BedBenchOptions {
   // Also the state digest after the timed steps (io/state_io.hpp): it serialises the whole state,
   // ≈ 2.4 kB a ball in memory, and is for checking bits (thread counts, builds), not for timing.
   bool digest = false;      // balls per block of the force pass (0: the engine's default); tuning only
+  // A named clump template (bodies/clump_shapes.hpp, named_template): each sphere of the bed becomes a
+  // clump of it, scaled to the sphere's diameter as its enclosing diameter (so that its pebbles lie
+  // inside the sphere and overlap no more than the spheres did), in a random orientation; the box is
+  // then not periodic (clumps are not supported in one). Empty: the spheres.
+  std::string clumps;
 };
 
 struct BedBenchResult {
-  std::size_t particles = 0;
+  std::size_t particles = 0;  // balls, pebbles included
+  std::size_t clumps = 0;     // (printed when > 0)
   std::int64_t steps = 0;
   double wall_seconds = 0.0;
   double particle_steps_per_second = 0.0;
@@ -54,6 +60,8 @@ struct BenchDecomposition {
 Simulation make_bed(const Packing& packing);
 // `decomposition`: null for the whole bed in this process.
 BedBenchResult run_bed_bench(const BedBenchOptions& options, const BenchDecomposition* decomposition = nullptr);
+// The bed with each sphere a clump of `unit` (see BedBenchOptions::clumps), orientations from `seed`.
+Simulation make_clump_bed(const Packing& packing, const ClumpTemplate& unit, std::uint64_t seed);
 
 // Settle a bed under hilldem's own contact laws (local damping 0.7, to a mean unbalanced-force
 // ratio of `ratio`) and write it as a LAMMPS data file, so that both codes time the same bed.

@@ -11,6 +11,9 @@
 
 namespace hilldem {
 
+// "No clump": a ball that is not a pebble (ClumpBodies::clump_of_balls).
+inline constexpr std::uint32_t kNoClump = 0xffffffffu;
+
 struct ClumpPebbles {
   std::vector<std::uint32_t> clump;  // index into ClumpState
   std::vector<Vec3> body_position;   // centre [m] in the clump's principal frame, from its centre of mass

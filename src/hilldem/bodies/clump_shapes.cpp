@@ -47,4 +47,19 @@ Pebbles fill_ellipsoid(const EllipsoidFill& f) {
   return p;
 }
 
+ClumpTemplate named_template(const std::string& name, double density) {
+  Pebbles p;
+  if (name == "sphere") {
+    p.position = {{0.0, 0.0, 0.0}};
+  } else if (name == "elongated2") {
+    p.position = {{-0.5, 0.0, 0.0}, {0.5, 0.0, 0.0}};
+  } else if (name == "elongated3") {
+    p.position = {{-1.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}};
+  } else {
+    throw InputError("unknown clump template '" + name + "'; known: " + kNamedTemplates);
+  }
+  p.radius.assign(p.position.size(), 1.0);
+  return make_template(p, density);
+}
+
 }  // namespace hilldem

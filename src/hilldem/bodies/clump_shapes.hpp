@@ -1,6 +1,8 @@
 // Clump templates from shapes (issue 32): pebbles that fill a shape, for make_template.
 #pragma once
 
+#include <string>
+
 #include "hilldem/bodies/clump_template.hpp"
 
 namespace hilldem {
@@ -21,6 +23,15 @@ struct EllipsoidFill {
   double smallest_ratio = 0.5;       // end pebbles' radius / c
 };
 Pebbles fill_ellipsoid(const EllipsoidFill& f);
+
+// Named templates for the command line (bench --clumps, docs/clumps.md), in units of the pebble
+// radius (scale them with ClumpTemplate::scaled): "sphere", one pebble of radius 1 (a clump that is
+// a ball: for comparing the two paths on one geometry); "elongated2", two equal pebbles of radius 1 with
+// centres 1 apart (length 3, width 2: aspect ratio 1.5); "elongated3", three equal pebbles in a row,
+// centres 1 apart (length 4: aspect ratio 2). Mass properties for density ρ [kg/m³] (sphere and elongated2
+// exact, elongated3 by columns at the default n). Throws InputError naming the known names.
+ClumpTemplate named_template(const std::string& name, double density);
+inline constexpr const char* kNamedTemplates = "sphere, elongated2, elongated3";
 
 // The volume (4/3)π a b c [m³] of the ellipsoid.
 double ellipsoid_volume(const EllipsoidFill& f);

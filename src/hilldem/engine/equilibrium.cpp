@@ -7,7 +7,8 @@
 
 namespace hilldem {
 
-double mean_unbalanced_ratio(const BallStore& balls, const ContactStore& contacts, const Vec3& gravity) {
+double mean_unbalanced_ratio(const BallStore& balls, const ContactStore& contacts, const Vec3& gravity,
+                             const ClumpBodies* clumps) {
   // PFC's mechanical ratio-average (spec lab-tests §3.4): the mean over free bodies of the
   // unbalanced-force magnitude over the mean over the same bodies of the applied-force magnitude,
   // that is the sum over a body's active contacts of |F_c| plus its weight m |g|. A contact's force
@@ -35,6 +36,25 @@ double mean_unbalanced_ratio(const BallStore& balls, const ContactStore& contact
     unbalanced += norm(f);
     applied_sum += applied[i] + balls.mass[i] * g;
     ++free_balls;
+  }
+  if (clumps) {
+    std::vector<Vec3> f(clumps->size());
+    std::vector<double> a(clumps->size(), 0.0);
+    for (std::size_t k = 0; k < clumps->ball.size(); ++k) {
+      const std::uint32_t b = clumps->ball[k], j = clumps->pebbles.clump[k];
+      f[j] += balls.contact_force[b] + balls.applied_force[b];
+      a[j] += applied[b];
+    }
+    const ClumpState& s = clumps->state;
+    for (std::size_t j = 0; j < s.size(); ++j) {
+      if ((s.fixity[j] & kFixVel) == kFixVel) continue;
+      Vec3 u = f[j] + gravity * s.mass[j];
+      for (int d = 0; d < 3; ++d)
+        if (s.fixity[j] & (1u << d)) u[d] = 0.0;
+      unbalanced += norm(u);
+      applied_sum += a[j] + s.mass[j] * g;
+      ++free_balls;
+    }
   }
   if (free_balls == 0) return 0.0;
   if (applied_sum == 0.0) return unbalanced > 0.0 ? 1.0 : 0.0;

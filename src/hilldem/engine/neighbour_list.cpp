@@ -5,6 +5,7 @@
 #include <limits>
 #include <string>
 
+#include "hilldem/bodies/clump_pebbles.hpp"
 #include "hilldem/core/error.hpp"
 
 namespace hilldem {
@@ -35,18 +36,24 @@ void sort_by_key(Candidates& all) {
   std::sort(all.begin(), all.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
 }
 
-// The ball-ball pairs within reach [m] of balls at `position` [m], with their periodic image.
+// The ball-ball pairs within reach [m] of balls at `position` [m], with their periodic image; none
+// between two pebbles of one clump (clump_of: per ball its clump, empty without clumps).
 void add_pair_candidates(Candidates& all, const std::vector<Vec3>& position, const BallStore& balls,
-                         const PeriodicBox& box, double reach) {
+                         const PeriodicBox& box, double reach, const std::vector<std::uint32_t>& clump_of) {
   const std::vector<PairCandidate> pairs = find_pair_candidates(position, balls.radius, reach, box);
   all.reserve(all.size() + pairs.size());
-  for (const PairCandidate& p : pairs) all.push_back({{p.i, ContactKind::BallBall, p.j}, p.image});
+  const bool clumps = !clump_of.empty();
+  for (const PairCandidate& p : pairs) {
+    if (clumps && clump_of[p.i] != kNoClump && clump_of[p.i] == clump_of[p.j]) continue;  // one rigid body
+    all.push_back({{p.i, ContactKind::BallBall, p.j}, p.image});
+  }
 }
 
 // The candidate pairs within reach [m], sorted by key (ball-ball with their periodic image).
-Candidates candidates(const BallStore& balls, const WallStore& walls, const PeriodicBox& box, double reach) {
+Candidates candidates(const BallStore& balls, const WallStore& walls, const PeriodicBox& box, double reach,
+                      const std::vector<std::uint32_t>& clump_of) {
   Candidates all;
-  add_pair_candidates(all, balls.position, balls, box, reach);
+  add_pair_candidates(all, balls.position, balls, box, reach, clump_of);
   for (std::uint32_t w = 0; w < walls.size(); ++w)
     for (std::uint32_t i = 0; i < balls.size(); ++i) {
       const auto touch = wall_touch(walls.walls[w], balls.position[i], balls.radius[i]);
@@ -74,10 +81,11 @@ void append_candidate(ContactStore& next, const ContactKey& key, ImageCode image
 }  // namespace
 
 void NeighbourList::rebuild(ContactStore& contacts, BallStore& balls, const WallStore& walls, const ModelTable& table,
-                            const PeriodicBox& box, double reach, std::int64_t step, const MapRow& map_row) {
+                            const PeriodicBox& box, double reach, std::int64_t step, const MapRow& map_row,
+                            const std::vector<std::uint32_t>& clump_of) {
   check_finite(balls, step);  // (before the wrap: the message gives the position the run reached)
   wrap_positions(balls, box);
-  const std::vector<std::pair<ContactKey, ImageCode>> all = candidates(balls, walls, box, reach);
+  const std::vector<std::pair<ContactKey, ImageCode>> all = candidates(balls, walls, box, reach, clump_of);
   // Merge with the existing rows (also sorted): history survives.
   ContactStore next;
   next.key.reserve(all.size());
@@ -106,13 +114,13 @@ void NeighbourList::rebuild(ContactStore& contacts, BallStore& balls, const Wall
 
 void NeighbourList::restore_rows(ContactStore& contacts, const BallStore& balls, const WallStore& walls,
                                  const ModelTable& table, const PeriodicBox& box, double reach,
-                                 const MapRow& map_row) const {
+                                 const MapRow& map_row, const std::vector<std::uint32_t>& clump_of) const {
   // The last rebuild's candidates are those at its positions (wrapped into the box then), found by
   // the same search; the saved rows (every contact, every wall row) stay as they were saved, and
   // the other ball-ball candidates become rows as the rebuild made them (a new row's columns are
   // those a contact forming on it resets: create_contact).
   Candidates pairs;
-  add_pair_candidates(pairs, position_at_build_, balls, box, reach);
+  add_pair_candidates(pairs, position_at_build_, balls, box, reach, clump_of);
   sort_by_key(pairs);
   ContactStore next;
   next.key.reserve(contacts.size() + pairs.size());

@@ -38,16 +38,19 @@ class NeighbourList {
   // §2.5). A new row takes its assignment rule's model and parameters (`table`); pairs no rule
   // matches are counted (unassigned_pairs). Positions are wrapped into the periodic box first.
   // Throws RunError for a ball with a non-finite position (`step`: for the message). The row lists
-  // are left to build_row_lists; built() ends the rebuild.
+  // are left to build_row_lists; built() ends the rebuild. clump_of: per ball its clump
+  // (ClumpBodies::clump_of_balls), empty without clumps: no rows between pebbles of one clump.
   void rebuild(ContactStore& contacts, BallStore& balls, const WallStore& walls, const ModelTable& table,
-               const PeriodicBox& box, double reach, std::int64_t step, const MapRow& map_row);
+               const PeriodicBox& box, double reach, std::int64_t step, const MapRow& map_row,
+               const std::vector<std::uint32_t>& clump_of = {});
   // After restore(): the rows of the last rebuild again, from a checkpoint that saved only the
   // contacts and the wall rows (`contacts`, sorted by key): the ball-ball rows that are not
-  // contacts are made as the rebuild made them, from its positions (position_at_build). Positions
-  // are not wrapped, and the next rebuild comes when the saved run's would: the cycles go on
-  // bitwise, in a periodic box too.
+  // contacts are made as the rebuild made them, from its positions (position_at_build; clump_of as
+  // for rebuild). Positions are not wrapped, and the next rebuild comes when the saved run's
+  // would: the cycles go on bitwise, in a periodic box too.
   void restore_rows(ContactStore& contacts, const BallStore& balls, const WallStore& walls, const ModelTable& table,
-                    const PeriodicBox& box, double reach, const MapRow& map_row) const;
+                    const PeriodicBox& box, double reach, const MapRow& map_row,
+                    const std::vector<std::uint32_t>& clump_of = {}) const;
   // The per-ball row lists of `n` balls from the current rows (in row order).
   void build_row_lists(const ContactStore& contacts, std::size_t n);
   // The rebuild is done at these positions [m]: the travel since counts from here.

@@ -14,6 +14,8 @@
 #include "hilldem/engine/model_dispatch.hpp"
 #include "hilldem/engine/thread_budget.hpp"
 #include "hilldem/motion/ball_step.hpp"
+#include "hilldem/motion/law_of_motion.hpp"
+#include "hilldem/motion/rigid_body.hpp"
 
 namespace hilldem {
 
@@ -57,6 +59,10 @@ void Simulation::throw_interrupted() const {
 
 void Simulation::update_forces() {
   drop_records();
+  if (!clumps.empty()) {
+    clumps.check(balls);
+    clumps.place_pebbles(balls);  // (bitwise what they hold when the clumps placed them last)
+  }
   rebuild_if_needed();
   write_results_ = true;
   force_pass(0.0);
@@ -106,7 +112,10 @@ void Simulation::step_body(bool last) {
     i_scaled = scaled_inertia_.data();
   }
   // §1.2 steps 1-2
-  if (ball_kin_.current() && ball_kin_.size() == balls.size()) {
+  if (!clumps.empty()) {
+    if (m_scaled) throw RunError("density scaling does not apply to clumps (docs/clumps.md): switch it off");
+    advance_with_clumps(dt);
+  } else if (ball_kin_.current() && ball_kin_.size() == balls.size()) {
     advance_records(dt, m_scaled, i_scaled, watched);
   } else {
     drop_records();
@@ -127,6 +136,17 @@ void Simulation::step_body(bool last) {
   ++steps;
   last_dt = dt;
   for (const auto& obs : observers) obs(*this);
+}
+
+void Simulation::advance_with_clumps(double dt) {
+  // On the columns, so that the travel since the neighbour list and the live rows is measured
+  // exactly (rebuild_if_needed): a pebble's motion is its clump's turn, not its own V Δt.
+  if (settings.box.any())
+    throw RunError("clumps in a periodic box are not supported (docs/clumps.md): a pebble's image would part from its clump");
+  drop_records();
+  const motion::ContactSums* sums = ball_kin_.contact_sums(balls.size());
+  advance_balls(balls, MotionSettings{settings.gravity, settings.local_damping}, dt, nullptr, nullptr, sums);
+  clumps.advance(balls, sums, RigidMotionSettings{settings.gravity, settings.local_damping}, dt);
 }
 
 ContactGeometry Simulation::geometry(std::size_t c) const {
@@ -220,7 +240,8 @@ void Simulation::rebuild(double proximity) {
   if (live_.records_ready()) live_.sync_records(contacts);  // (the rows are made anew, their history by key)
   const double reach = proximity + skin();
   neighbours_.rebuild(contacts, balls, walls, table, settings.box, reach, steps,
-                      [this](ContactStore& store, std::size_t c) { compute_mapping(balls, store, c); });
+                      [this](ContactStore& store, std::size_t c) { compute_mapping(balls, store, c); },
+                      clumps.clump_of_balls(balls.size()));
   build_row_lists();
   neighbours_.built(balls.position);
   body_terms_ready_ = false;
@@ -251,6 +272,7 @@ void Simulation::restore_cycle_state(CycleState s) {
   // The force pass finds a ball's rows by position in the sorted list (NeighbourList::first_rows).
   for (std::size_t c = 1; c < contacts.size(); ++c)
     if (!(contacts.key[c - 1] < contacts.key[c])) throw RunError("cycle state: contact rows are not sorted by key");
+  if (!clumps.empty()) clumps.check(balls);
   forces_ready_ = s.forces_ready;
   ball_kin_.forget_sums();  // the restored columns hold the sums the next step moves with
   const bool rebuild_needed = s.rebuild_needed || s.position_at_build.empty();  // (before the move below)
@@ -258,7 +280,8 @@ void Simulation::restore_cycle_state(CycleState s) {
                       std::move(s.position_at_build), s.wall_travel);
   if (!rebuild_needed && !s.rows_complete)
     neighbours_.restore_rows(contacts, balls, walls, table, settings.box, settings.proximity + skin(),
-                             [this](ContactStore& store, std::size_t c) { compute_mapping(balls, store, c); });
+                             [this](ContactStore& store, std::size_t c) { compute_mapping(balls, store, c); },
+                             clumps.clump_of_balls(balls.size()));
   body_terms_ready_ = false;
   build_row_lists();
 }
@@ -319,7 +342,13 @@ void Simulation::prepare_pass() {
 double Simulation::estimate_timestep() const {
   // Per-body sums of the contact-returned stiffnesses (spec §4; hill Eqs. 19-21, linear k_n, k_s),
   // stored by the last force pass.
-  const double crit = stiffness_.critical_timestep(balls, contacts, neighbours_);
+  double crit = stiffness_.critical_timestep(balls, contacts, neighbours_);
+  if (!clumps.empty()) {
+    std::vector<double> k_tran(clumps.ball.size()), k_rot(clumps.ball.size());
+    for (std::size_t k = 0; k < k_tran.size(); ++k)
+      stiffness_.of_ball(clumps.ball[k], balls, contacts, neighbours_, k_tran[k], k_rot[k]);
+    crit = std::min(crit, std::sqrt(clumps.critical_timestep2(k_tran, k_rot)));
+  }
   return std::isfinite(crit) ? settings.timestep_safety * crit : 0.0;
 }
 
@@ -370,7 +399,9 @@ long Simulation::find_ball_wall(std::int64_t ball_id, std::size_t wall) const {
 void Simulation::sort_balls_spatially() {
   if (contact_count() > 0) throw RunError("sort_balls_spatially: only before any contact exists");
   if (balls.size() < 2) return;
-  balls.permute(spatial_order(balls));
+  const std::vector<std::uint32_t> order = spatial_order(balls);
+  balls.permute(order);
+  clumps.balls_permuted(order);
   contacts.clear();
   invalidate_forces();
 }

@@ -21,6 +21,7 @@
 #include "hilldem/bodies/wall_store.hpp"
 #include "hilldem/contact/contact_store.hpp"
 #include "hilldem/engine/ball_records.hpp"
+#include "hilldem/engine/clump_bodies.hpp"
 #include "hilldem/engine/equilibrium.hpp"
 #include "hilldem/engine/force_pass.hpp"
 #include "hilldem/engine/hill_param_sets.hpp"
@@ -61,6 +62,9 @@ class Simulation {
   ModelTable table;
   GroupNames groups;
   SimulationSettings settings;
+  // Clumps (docs/clumps.md): rigid bodies whose pebbles are rows of `balls`, moved by their clump.
+  // After adding clumps (ClumpBodies::add), call invalidate_forces().
+  ClumpBodies clumps;
 
   double time = 0.0;        // [s]
   std::int64_t steps = 0;   // cycles done
@@ -101,9 +105,11 @@ class Simulation {
   double next_timestep() const;
   // f·Δt_crit from the contact stiffnesses (spec §4, hill Eqs. 19-21), or 0 if no contact reports one.
   double estimate_timestep() const;
-  // PFC's mechanical ratio-average [-]: mean unbalanced-force magnitude over free balls / mean
-  // applied-force magnitude over the same balls (their contacts' |F_c| and their weight).
-  double mean_unbalanced_ratio() const { return hilldem::mean_unbalanced_ratio(balls, contacts, settings.gravity); }
+  // PFC's mechanical ratio-average [-]: mean unbalanced-force magnitude over free bodies (balls and
+  // clumps) / mean applied-force magnitude over the same bodies (their contacts' |F_c| and weight).
+  double mean_unbalanced_ratio() const {
+    return hilldem::mean_unbalanced_ratio(balls, contacts, settings.gravity, clumps.empty() ? nullptr : &clumps);
+  }
 
   // Material-level wetting (spec §2.7): contacts for every ball pair within gap [m] (new ones
   // included), suction [Pa] on their hill contacts, make_wet(gap) on every hill contact. Returns the
@@ -173,6 +179,8 @@ class Simulation {
   // One cycle; `last`: the last of a cycle() call (its contact results are written).
   void step_once(bool last);
   void step_body(bool last);  // step_once's work (step_once syncs the columns if it throws)
+  // §1.2 steps 1-2 with clumps: the balls on the columns, then the clumps, which place their pebbles.
+  void advance_with_clumps(double dt);
   void rebuild(double reach);
   void build_row_lists();  // the neighbour list's row lists, and the force pass's per-row state
   void rebuild_if_needed();

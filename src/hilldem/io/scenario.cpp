@@ -11,6 +11,7 @@
 #include "hilldem/core/error.hpp"
 #include "hilldem/io/output_folder.hpp"
 #include "hilldem/io/packing_import.hpp"
+#include "hilldem/io/scenario_clumps.hpp"
 #include "hilldem/io/state_io.hpp"
 
 #include <filesystem>
@@ -109,6 +110,10 @@ class Reader {
     for (TableReader& t : root_.tables("ball")) read_ball(t, sc.sim);
     for (TableReader& t : root_.tables("ball_grid")) read_ball_grid(t, sc.sim);
     for (TableReader& t : root_.tables("packing")) read_packing_table(t, sc.sim);
+    for (TableReader& t : root_.tables("clump_template")) read_clump_template(t, sc.sim);
+    for (TableReader& t : root_.tables("clump")) read_clump(t, sc.sim);
+    if (sc.sim.settings.density_scaling && !sc.sim.clumps.empty())
+      throw InputError(file_ + ": key 'simulation.density_scaling': does not apply to clumps (docs/clumps.md); set it false");
     finish_box(sc.sim);
     for (TableReader& t : root_.tables("wall")) read_wall(t, sc.sim);
     for (TableReader& t : root_.tables("servo")) read_servo(t, sc);
@@ -116,8 +121,8 @@ class Reader {
     for (TableReader& t : root_.tables("history")) read_history(t, sc);
     for (TableReader& t : root_.tables("stage")) read_stage(t, sc);
     root_.finish();
-    if (sc.sim.balls.size() == 0)
-      throw InputError(file_ + ": the scenario has no balls ([[ball]], [[ball_grid]] or [[packing]])");
+    if (sc.sim.balls.size() == 0 && sc.sim.clumps.empty())
+      throw InputError(file_ + ": the scenario has no balls ([[ball]], [[ball_grid]], [[packing]] or [[clump]])");
     check_hill_moduli(sc.sim);
     return sc;
   }
@@ -427,6 +432,43 @@ class Reader {
     }
   }
 
+  // [[clump_template]]: a shape and its mass properties (io/scenario_clumps.hpp), of a material.
+  void read_clump_template(TableReader& t, SimulationDescription& sim) {
+    const std::string name = t.string("name", std::nullopt);
+    if (templates_.count(name)) t.fail("name", "clump template \"" + name + "\" is defined twice");
+    const Material& m = material(t);
+    sim.clump_templates.push_back(read_clump_template_shape(t, m.density));
+    t.finish();
+    templates_[name] = {sim.clump_templates.size() - 1, m};
+  }
+
+  // [[clump]]: a clump of a template; its pebbles are balls first_id, first_id + 1, ...
+  void read_clump(TableReader& t, SimulationDescription& sim) {
+    const std::string name = t.string("template", std::nullopt);
+    const auto it = templates_.find(name);
+    if (it == templates_.end()) t.fail("template", "no [[clump_template]] named \"" + name + "\"");
+    const auto& [index, m] = it->second;
+    SimulationDescription::Clump c;
+    c.tmpl = index;
+    c.init.first_ball_id = t.integer("first_id", std::nullopt, 0, INT64_MAX / 2);
+    read_clump_placement(t, c.init);
+    c.init.groups = read_groups(t, sim.groups);
+    c.init.fixity = read_fixity(t, "fix");
+    c.init.young_mod = m.young_mod;
+    c.init.pois_ratio = m.pois_ratio;
+    t.finish();
+    const std::size_t n = sim.clump_templates[index].pebbles.size();
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::int64_t id = c.init.first_ball_id + static_cast<std::int64_t>(k);
+      if (!ids_.emplace(id, sim.balls.size() + pebble_count_ + k).second)
+        t.fail("first_id", "ball id " + std::to_string(id) + " (pebble " + std::to_string(k) + ") is used twice");
+    }
+    pebble_count_ += n;
+    if (sim.balls.size() + pebble_count_ > limits_.max_balls)
+      t.fail("first_id", "more than " + std::to_string(limits_.max_balls) + " balls and pebbles (the limit for one scenario)");
+    sim.clumps.push_back(c);
+  }
+
   // The hill model needs E > 0 on both balls (spec §2.4): refuse a material without it when a hill
   // rule can apply to its balls.
   void check_hill_moduli(const SimulationDescription& sim) {
@@ -440,11 +482,20 @@ class Reader {
                                        "can apply to it; the hill model needs young_mod in (0, inf) [Pa]",
                                        file_, sim.balls[i].id, r.name));
       }
+      for (const SimulationDescription::Clump& c : sim.clumps) {
+        const bool in_rule = (r.groups1 == 0 || (c.init.groups & r.groups1)) || (r.groups2 == 0 || (c.init.groups & r.groups2));
+        if (in_rule && !(c.init.young_mod > 0.0))
+          throw InputError(fmt::format("{}: key 'material.young_mod': the clump of ball {} has young_mod = 0 but the hill rule "
+                                       "'{}' can apply to it; the hill model needs young_mod in (0, inf) [Pa]",
+                                       file_, c.init.first_ball_id, r.name));
+      }
     }
   }
 
   void finish_box(SimulationDescription& sim) {
     if (!sim.settings.box.any()) return;
+    if (!sim.clumps.empty())
+      throw InputError(file_ + ": key 'simulation.periodic': clumps in a periodic box are not supported (docs/clumps.md)");
     if (!box_given_)
       throw InputError(file_ + ": key 'simulation.periodic' needs simulation.box_min and box_max [m] (or a [[packing]] LAMMPS file with a box)");
     for (std::size_t i = 0; i < sim.balls.size(); ++i)
@@ -746,6 +797,12 @@ class Reader {
   ScenarioLimits limits_;
   std::map<std::string, Material> materials_;
   std::map<std::int64_t, std::size_t> ids_;  // ball id -> index
+  struct TemplateEntry {
+    std::size_t index;
+    Material material;
+  };
+  std::map<std::string, TemplateEntry> templates_;  // clump template name -> index, material
+  std::size_t pebble_count_ = 0;                     // pebbles of the clumps read so far
   std::set<std::string> wall_names_, labels_;
   bool box_given_ = false;
 };

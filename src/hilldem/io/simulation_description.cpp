@@ -21,6 +21,7 @@ Simulation build_simulation(const SimulationDescription& d) {
   sim.settings = d.settings;
   sim.groups = d.groups;
   for (const BallInit& b : d.balls) sim.balls.add(b);
+  for (const SimulationDescription::Clump& c : d.clumps) sim.clumps.add(sim.balls, d.clump_templates[c.tmpl], c.init);
   for (const Wall& w : d.walls) sim.walls.add(w);
   sim.table.rules = d.rules;
   return sim;

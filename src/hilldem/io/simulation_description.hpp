@@ -18,6 +18,14 @@ struct SimulationDescription {
   std::vector<BallInit> balls;   // ball i becomes index i
   std::vector<Wall> walls;       // wall k becomes index k
   std::vector<ModelRule> rules;  // the assignment table (the first matching rule applies)
+  // Clumps, added after the balls (their pebbles are the balls that follow): templates, and each
+  // clump's template index and placement.
+  std::vector<ClumpTemplate> clump_templates;
+  struct Clump {
+    std::size_t tmpl = 0;
+    ClumpInit init;
+  };
+  std::vector<Clump> clumps;
 
   // Index of the ball with user id `id`, or -1.
   long find_ball(std::int64_t id) const;

@@ -244,6 +244,8 @@ bool all_finite(const T& v) {
     return std::isfinite(v);
   } else if constexpr (std::is_same_v<T, Vec3>) {
     return finite3(v);
+  } else if constexpr (std::is_same_v<T, Quat>) {
+    return std::isfinite(v.w) && std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
   } else if constexpr (std::is_same_v<T, HillParams> || std::is_same_v<T, HillMapping> || std::is_same_v<T, LinearParams> ||
                        std::is_same_v<T, LinearMapping>) {
     static_assert(sizeof(T) % sizeof(double) == 0);
@@ -270,6 +272,42 @@ constexpr const char* kContactColumns[] = {
 template <std::size_t N>
 std::string column_name(const char* const (&names)[N], std::size_t k) {
   return k < N ? names[k] : "column " + std::to_string(k + 1);
+}
+
+// sim.clumps: every ClumpBodies column, validated against the balls read before.
+void read_clumps(SectionReader r, Simulation& sim) {
+  ClumpBodies c;
+  std::uint32_t expected = 0;
+  c.for_each_column([&](auto&) { ++expected; });
+  const std::uint32_t columns = r.u32();
+  if (columns != expected)
+    r.fail(std::to_string(columns) + " clump columns, this build has " + std::to_string(expected) +
+           " (written by an incompatible hilldem build)");
+  std::size_t k = 0;
+  c.for_each_column([&](auto& col) {
+    const char* name = ClumpBodies::kColumnNames[k++];
+    get_column(r, col, name);
+    for (const auto& x : col)
+      if (!all_finite(x)) r.fail(std::string("clump column '") + name + "' has a non-finite value");
+  });
+  r.finish();
+  const std::size_t n = c.state.position.size();
+  bool even = c.state.velocity.size() == n && c.state.orientation.size() == n && c.state.spin.size() == n &&
+              c.state.body_momentum.size() == n && c.state.mass.size() == n && c.state.principal_inertia.size() == n &&
+              c.state.fixity.size() == n && c.groups.size() == n;
+  if (!even) r.fail("the clump columns have different lengths");
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3& in = c.state.principal_inertia[i];
+    if (!(c.state.mass[i] > 0.0 && in.x > 0.0 && in.y > 0.0 && in.z > 0.0))
+      r.fail("clump " + std::to_string(i) + " has a mass or principal moment that is not positive");
+    if (c.state.fixity[i] > kFixAll) r.fail("clump " + std::to_string(i) + " has fixity bits beyond the six components");
+  }
+  try {
+    c.check(sim.balls);
+  } catch (const RunError& e) {
+    r.fail(e.what());
+  }
+  sim.clumps = std::move(c);
 }
 
 void check_contacts(SectionReader& r, const ContactStore& c, std::size_t n_balls, std::size_t n_walls, std::size_t n_rules) {
@@ -348,6 +386,15 @@ void write_simulation(CheckpointWriter& w, const Simulation& sim) {
     balls.for_each_column([&](auto&) { ++columns; });
     s.u32(columns);
     balls.for_each_column([&](auto& col) { put_column(s, col); });
+  }
+  if (!sim.clumps.empty()) {
+    // (Only with clumps: a checkpoint without them is as before, and reads in builds before them.)
+    SectionWriter& s = w.section("sim.clumps");
+    auto& clumps = const_cast<ClumpBodies&>(sim.clumps);  // for_each_column is non-const; only read here
+    std::uint32_t columns = 0;
+    clumps.for_each_column([&](auto&) { ++columns; });
+    s.u32(columns);
+    clumps.for_each_column([&](auto& col) { put_column(s, col); });
   }
   {
     SectionWriter& s = w.section("sim.walls");
@@ -477,6 +524,7 @@ void read_simulation(const CheckpointReader& cr, Simulation& out, bool prepare_t
     k = 0;
     sim.balls.for_each_column([&](auto& col) { get_column(again, col, column_name(kBallColumns, k++).c_str()); });
   }
+  if (cr.has("sim.clumps")) read_clumps(cr.section("sim.clumps"), sim);
   {
     SectionReader r = cr.section("sim.walls");
     const std::uint64_t n = r.count(8, kMaxWalls);
@@ -622,6 +670,15 @@ std::vector<Part> state_parts(const Simulation& sim) {
     put_column(s, col);
     parts.push_back({"ball column '" + column_name(kBallColumns, k++) + "'", s.bytes()});
   });
+  if (!sim.clumps.empty()) {
+    k = 0;
+    auto& clumps = const_cast<ClumpBodies&>(sim.clumps);  // only read here
+    clumps.for_each_column([&](auto& col) {
+      SectionWriter s;
+      put_column(s, col);
+      parts.push_back({std::string("clump column '") + ClumpBodies::kColumnNames[k++] + "'", s.bytes()});
+    });
+  }
   for (const Wall& w : sim.walls.walls) {
     SectionWriter s;
     write_wall(s, w);

@@ -202,6 +202,10 @@ void write_balls_vtp(const Simulation& sim, const std::string& path, bool binary
     if (b.groups[i]) group[i] = std::countr_zero(b.groups[i]);
     fixity[i] = b.fixity[i];
   }
+  // The clump of each pebble (its index), -1 for a ball that is none: ParaView colours the shapes by it.
+  std::vector<std::int32_t> clump_id(n, -1);
+  for (std::size_t k = 0; k < sim.clumps.ball.size(); ++k)
+    clump_id[sim.clumps.ball[k]] = static_cast<std::int32_t>(sim.clumps.pebbles.clump[k]);
   f.point_data = {make_array("id", b.id),
                   make_array("radius", b.radius),
                   make_array("mass", b.mass),
@@ -214,7 +218,8 @@ void write_balls_vtp(const Simulation& sim, const std::string& path, bool binary
                   make_array("group", group),
                   make_array("coordination", coordination),
                   make_array("wet_contacts", wet),
-                  make_array("moisture_force", moisture)};
+                  make_array("moisture_force", moisture),
+                  make_array("clump_id", clump_id)};
   for (std::size_t i = 0; i < n; ++i) {
     f.vert_conn.push_back(static_cast<std::int64_t>(i));
     f.vert_off.push_back(static_cast<std::int64_t>(i + 1));
