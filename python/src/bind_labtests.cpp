@@ -8,7 +8,12 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <atomic>
+#include <chrono>
+#include <functional>
 #include <iostream>
+#include <mutex>
+#include <optional>
 #include <sstream>
 
 #include "bindings.hpp"
@@ -322,12 +327,70 @@ py::dict study_dict(const StudyResult& s) {
 // A driver's log: the console (as the CLI prints it) or nothing.
 std::ostream* log_stream(bool log) { return log ? &std::cout : nullptr; }
 
-// Runs f() with the GIL released (the drivers run for seconds to hours; Python threads go on).
+// Ctrl-C in a lab call. The drivers' Simulations ask the hook before every cycle
+// (Simulation::interrupt), from the calling thread or from a study's job threads; every 0.05 s one
+// of them takes the GIL and runs Python's signal handlers. Once a handler raised, every driver stops
+// at its next cycle (Interrupted) and the call raises what the handler raised (KeyboardInterrupt).
+class LabStopHook {
+ public:
+  bool operator()() {
+    if (stop_.load()) return true;
+    std::unique_lock<std::mutex> lock(mutex_, std::try_to_lock);  // (one thread polls; the others go on)
+    if (!lock) return false;
+    const auto now = std::chrono::steady_clock::now();
+    if (now < next_poll_) return false;
+    next_poll_ = now + std::chrono::milliseconds(50);
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() == 0) return false;
+    error_.emplace();  // takes the pending Python exception
+    stop_ = true;
+    return true;
+  }
+  // With the GIL, after an Interrupted: raise what the signal handler raised.
+  [[noreturn]] void rethrow() {
+    if (error_) {
+      py::error_already_set e = std::move(*error_);
+      error_.reset();
+      throw e;
+    }
+    throw;  // (an Interrupted that this hook did not ask for)
+  }
+
+ private:
+  std::atomic<bool> stop_{false};
+  std::mutex mutex_;
+  std::chrono::steady_clock::time_point next_poll_ = std::chrono::steady_clock::now();
+  std::optional<py::error_already_set> error_;
+};
+
+// Runs f(stop) with the GIL released (the drivers run for seconds to hours; Python threads go on),
+// stop being the hook for Simulation::interrupt and GenesisSpec::interrupt: Ctrl-C raises
+// KeyboardInterrupt with the specimen at a cycle boundary.
 template <class F>
 auto released(F&& f) {
-  py::gil_scoped_release release;
-  return f();
+  LabStopHook hook;
+  try {
+    py::gil_scoped_release release;
+    return f(std::function<bool()>(std::ref(hook)));
+  } catch (const Interrupted&) {
+    hook.rethrow();
+  }
 }
+
+// A specimen's Simulation asks `stop` while a driver runs on it, and nothing after.
+class SpecimenStop {
+ public:
+  SpecimenStop(Specimen& s, std::function<bool()> stop) : s_(s), before_(std::move(s.sim.interrupt)) {
+    s_.sim.interrupt = std::move(stop);
+  }
+  ~SpecimenStop() { s_.sim.interrupt = std::move(before_); }
+  SpecimenStop(const SpecimenStop&) = delete;
+  SpecimenStop& operator=(const SpecimenStop&) = delete;
+
+ private:
+  Specimen& s_;
+  std::function<bool()> before_;
+};
 
 py::array_t<double> diameters(const Specimen& s) {
   const std::vector<double> d = s.diameters();
@@ -569,7 +632,13 @@ the PackingSettings it was packed with (its contact and wall settings are record
 
   lab.def("pack_specimen", [](const GenesisSpec& spec, bool log) {
             validate(spec);
-            return released([&] { return pack_specimen(spec, log_stream(log)); });
+            return released([&](std::function<bool()> stop) {
+              GenesisSpec g = spec;
+              g.interrupt = std::move(stop);
+              Specimen s = pack_specimen(g, log_stream(log));
+              s.sim.interrupt = {};
+              return s;
+            });
           },
           py::arg("spec"), py::arg("log") = false,
           R"(Genesis up to the packed, frictionless specimen (cloud, relaxation, servo packing to P_m): a
@@ -581,25 +650,37 @@ Specimen. log: print the phases as the CLI does. RunError when a phase does not 
           },
           py::arg("path"), "A saved packed specimen: (Specimen, the PackingSettings stored with it).");
   lab.def("finalize", [](Specimen& s, const Class5Material& m, const WallContact& w, const EquilibriumSettings& e, bool log) {
-            return phase_dict(released([&] { return finalize(s, m, w, e, log_stream(log)); }));
+            return phase_dict(released([&](std::function<bool()> stop) {
+              const SpecimenStop scope(s, std::move(stop));
+              return finalize(s, m, w, e, log_stream(log));
+            }));
           },
           py::arg("specimen"), py::arg("material"), py::arg("walls") = WallContact{}, py::arg("equilibrium") = EquilibriumSettings{},
           py::arg("log") = false,
           "Install the material (friction restored) and bring the specimen to equilibrium at equilibrium.pressure [Pa]; the phase dict.");
   lab.def("make_wet", [](Specimen& s, double suction, double gap, const EquilibriumSettings& e, bool log) {
-            return phase_dict(released([&] { return make_specimen_wet(s, suction, gap, e, log_stream(log)); }));
+            return phase_dict(released([&](std::function<bool()> stop) {
+              const SpecimenStop scope(s, std::move(stop));
+              return make_specimen_wet(s, suction, gap, e, log_stream(log));
+            }));
           },
           py::arg("specimen"), py::arg("suction"), py::arg("gap"), py::arg("equilibrium") = EquilibriumSettings{},
           py::arg("log") = false,
           "make_wet(suction [Pa], gap [m]) on a finalized hill specimen, then servo equilibrium; the phase dict.");
   lab.def("servo_equilibrium", [](Specimen& s, const EquilibriumSettings& e, const std::string& name, bool log) {
-            return phase_dict(released([&] { return servo_equilibrium(s, e, name, log_stream(log)); }));
+            return phase_dict(released([&](std::function<bool()> stop) {
+              const SpecimenStop scope(s, std::move(stop));
+              return servo_equilibrium(s, e, name, log_stream(log));
+            }));
           },
           py::arg("specimen"), py::arg("equilibrium"), py::arg("name") = "equilibrium", py::arg("log") = false,
           "Every wall to equilibrium.pressure [Pa] and static equilibrium; the phase dict.");
   lab.def("triaxial", [](Specimen& s, const TriaxialSettings& t, bool log) {
             validate(t);
-            return triaxial_dict(released([&] { return run_triaxial(s, t, log_stream(log)); }));
+            return triaxial_dict(released([&](std::function<bool()> stop) {
+              const SpecimenStop scope(s, std::move(stop));
+              return run_triaxial(s, t, log_stream(log));
+            }));
           },
           py::arg("specimen"), py::arg("settings"), py::arg("log") = false,
           R"(The triaxial test on a finalized specimen. Returns {'history': {column: numpy array}, 'loops':
@@ -613,7 +694,10 @@ reload_secant (two-point secants) [Pa], loop_area [J/m^3], damping_ratio [-].)")
   lab.def("memo_cases", &memo_cases, "The memo's five cases: C5n/C5b x linear/hill, plus C5b hill wet.");
   lab.def("t307", [](Specimen& s, const T307Settings& t, bool log) {
             validate(t);
-            return t307_dict(released([&] { return run_t307(s, t, log_stream(log)); }));
+            return t307_dict(released([&](std::function<bool()> stop) {
+              const SpecimenStop scope(s, std::move(stop));
+              return run_t307(s, t, log_stream(log));
+            }));
           },
           py::arg("specimen"), py::arg("settings") = T307Settings{}, py::arg("log") = false,
           R"(AASHTO T 307 (time-scaled, docs/t307.md) on a finalized specimen. Returns {'rows': {column: numpy
@@ -628,7 +712,11 @@ total_permanent_strain, amplitude_error [-], steps. Cycle columns: sequence, cyc
 sigma_r_peak [Pa], recoverable_axial, recoverable_radial, eps_a_end [-], modulus, command [Pa],
 amplitude_error [-].)");
   lab.def("study", [](const StudySettings& s, const std::vector<CaseSpec>& cases, bool log) {
-            return study_dict(released([&] { return run_study(s, cases, log_stream(log)); }));
+            return study_dict(released([&](std::function<bool()> stop) {
+              StudySettings st = s;
+              st.genesis.interrupt = std::move(stop);
+              return run_study(st, cases, log_stream(log));
+            }));
           },
           py::arg("settings"), py::arg("cases"), py::arg("log") = false,
           R"(The study as `hilldem triaxial` runs it: per case genesis (or settings.specimen_file), finalization,

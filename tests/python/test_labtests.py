@@ -179,3 +179,31 @@ def test_t307_from_python_is_the_clis(cli, source_dir, tmp_path):
         bad = lab.T307Settings()
         bad.timing.cycles = 0
         lab.t307(s, bad)
+
+
+def test_ctrl_c_stops_a_lab_test_between_cycles(source_dir):
+    """Ctrl-C in a lab call (here T 307, far from its end): KeyboardInterrupt within about 0.05 s, the
+    specimen at a cycle boundary, and nothing left asking once the call is over."""
+    import os
+    import signal
+    import threading
+    import time
+
+    specimen, _ = mini_files(source_dir)
+    s, _ = lab.load_specimen(specimen)
+    st = lab.StudySettings()
+    material = st.material
+    material.model = lab.GrainModel.Hill
+    lab.finalize(s, material, st.test_walls, st.finalize)
+    before = s.simulation().steps
+    t = lab.T307Settings()
+    t.timing.conditioning_cycles = 1000  # minutes of work: the interrupt must come first
+    timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    start = time.monotonic()
+    with pytest.raises(KeyboardInterrupt):
+        lab.t307(s, t)
+    assert time.monotonic() - start < 10.0
+    assert s.simulation().steps > before
+    phase = lab.servo_equilibrium(s, st.finalize)  # the specimen goes on, uninterrupted
+    assert phase["steps"] > 0
