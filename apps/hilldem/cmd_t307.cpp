@@ -47,11 +47,6 @@ struct Options {
   bool quiet = false;
 };
 
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
 struct Plan {
   StudySettings study;
   CaseSpec c;

@@ -64,11 +64,6 @@ struct Options {
   bool quiet = false;
 };
 
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
 // Options -> settings and cases; every check that can fail does so here, before any work.
 std::pair<StudySettings, std::vector<CaseSpec>> build(const Options& o) {
   StudySettings s;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <cctype>
 #include <cmath>
 #include <fmt/format.h>
 #include <functional>
@@ -33,6 +34,12 @@ inline CLI::Validator finite_range(double lo, double hi, const std::string& unit
       },
       range);
 }
+// An option's word in lower case, for case-insensitive choices (--material HILL, --vessel T307).
+inline std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
 inline CLI::Validator finite_number() { return finite_range(-HUGE_VAL, HUGE_VAL, ""); }
 
 // The figures of a lab command: `/usr/bin/python3 SCRIPT FOLDER` (SCRIPT relative to the working

@@ -392,6 +392,15 @@ class SpecimenStop {
   std::function<bool()> before_;
 };
 
+// released() for a driver on specimen s: f() runs with s answering Ctrl-C.
+template <class F>
+auto released_on(Specimen& s, F&& f) {
+  return released([&](std::function<bool()> stop) {
+    const SpecimenStop scope(s, std::move(stop));
+    return f();
+  });
+}
+
 py::array_t<double> diameters(const Specimen& s) {
   const std::vector<double> d = s.diameters();
   return py::array_t<double>(static_cast<py::ssize_t>(d.size()), d.data());
@@ -650,37 +659,25 @@ Specimen. log: print the phases as the CLI does. RunError when a phase does not 
           },
           py::arg("path"), "A saved packed specimen: (Specimen, the PackingSettings stored with it).");
   lab.def("finalize", [](Specimen& s, const Class5Material& m, const WallContact& w, const EquilibriumSettings& e, bool log) {
-            return phase_dict(released([&](std::function<bool()> stop) {
-              const SpecimenStop scope(s, std::move(stop));
-              return finalize(s, m, w, e, log_stream(log));
-            }));
+            return phase_dict(released_on(s, [&] { return finalize(s, m, w, e, log_stream(log)); }));
           },
           py::arg("specimen"), py::arg("material"), py::arg("walls") = WallContact{}, py::arg("equilibrium") = EquilibriumSettings{},
           py::arg("log") = false,
           "Install the material (friction restored) and bring the specimen to equilibrium at equilibrium.pressure [Pa]; the phase dict.");
   lab.def("make_wet", [](Specimen& s, double suction, double gap, const EquilibriumSettings& e, bool log) {
-            return phase_dict(released([&](std::function<bool()> stop) {
-              const SpecimenStop scope(s, std::move(stop));
-              return make_specimen_wet(s, suction, gap, e, log_stream(log));
-            }));
+            return phase_dict(released_on(s, [&] { return make_specimen_wet(s, suction, gap, e, log_stream(log)); }));
           },
           py::arg("specimen"), py::arg("suction"), py::arg("gap"), py::arg("equilibrium") = EquilibriumSettings{},
           py::arg("log") = false,
           "make_wet(suction [Pa], gap [m]) on a finalized hill specimen, then servo equilibrium; the phase dict.");
   lab.def("servo_equilibrium", [](Specimen& s, const EquilibriumSettings& e, const std::string& name, bool log) {
-            return phase_dict(released([&](std::function<bool()> stop) {
-              const SpecimenStop scope(s, std::move(stop));
-              return servo_equilibrium(s, e, name, log_stream(log));
-            }));
+            return phase_dict(released_on(s, [&] { return servo_equilibrium(s, e, name, log_stream(log)); }));
           },
           py::arg("specimen"), py::arg("equilibrium"), py::arg("name") = "equilibrium", py::arg("log") = false,
           "Every wall to equilibrium.pressure [Pa] and static equilibrium; the phase dict.");
   lab.def("triaxial", [](Specimen& s, const TriaxialSettings& t, bool log) {
             validate(t);
-            return triaxial_dict(released([&](std::function<bool()> stop) {
-              const SpecimenStop scope(s, std::move(stop));
-              return run_triaxial(s, t, log_stream(log));
-            }));
+            return triaxial_dict(released_on(s, [&] { return run_triaxial(s, t, log_stream(log)); }));
           },
           py::arg("specimen"), py::arg("settings"), py::arg("log") = false,
           R"(The triaxial test on a finalized specimen. Returns {'history': {column: numpy array}, 'loops':
@@ -694,10 +691,7 @@ reload_secant (two-point secants) [Pa], loop_area [J/m^3], damping_ratio [-].)")
   lab.def("memo_cases", &memo_cases, "The memo's five cases: C5n/C5b x linear/hill, plus C5b hill wet.");
   lab.def("t307", [](Specimen& s, const T307Settings& t, bool log) {
             validate(t);
-            return t307_dict(released([&](std::function<bool()> stop) {
-              const SpecimenStop scope(s, std::move(stop));
-              return run_t307(s, t, log_stream(log));
-            }));
+            return t307_dict(released_on(s, [&] { return run_t307(s, t, log_stream(log)); }));
           },
           py::arg("specimen"), py::arg("settings") = T307Settings{}, py::arg("log") = false,
           R"(AASHTO T 307 (time-scaled, docs/t307.md) on a finalized specimen. Returns {'rows': {column: numpy

@@ -284,17 +284,19 @@ TEST(Determinism, TwoRunsAreBitwiseIdentical) {
   for (std::size_t i = 0; i < a.size(); ++i) EXPECT_TRUE(a[i] == b[i]) << "ball " << i;
 }
 
+// 200 balls in a box under gravity, damped, with wet contacts: a state whose every cycle counts.
+Simulation wet_damped_box() {
+  Simulation sim = random_box(200, 3);
+  sim.settings.gravity = {0, 0, -9.81};
+  sim.settings.local_damping = 0.7;
+  sim.make_wet(20e3, 1e-3);
+  return sim;
+}
+
 // cycle(n, stop): once stop() says so, the coming cycle is the last; the state is bitwise cycle(k)'s,
 // contact results included, and cycling on continues as an uninterrupted run.
 TEST(Cycle, StoppedByTheHookIsTheStateOfThatManyCycles) {
-  auto make = [] {
-    Simulation sim = random_box(200, 3);
-    sim.settings.gravity = {0, 0, -9.81};
-    sim.settings.local_damping = 0.7;
-    sim.make_wet(20e3, 1e-3);
-    return sim;
-  };
-  Simulation hooked = make(), plain = make();
+  Simulation hooked = wet_damped_box(), plain = wet_damped_box();
   int asked = 0;
   const std::int64_t ran = hooked.cycle(1000, [&] { return ++asked == 37; });
   EXPECT_EQ(ran, 37);
@@ -310,14 +312,7 @@ TEST(Cycle, StoppedByTheHookIsTheStateOfThatManyCycles) {
 // Simulation::interrupt: once it answers true, that cycle is the last and the call throws Interrupted
 // naming the step; the state is bitwise that many cycles', in cycle() and in solve().
 TEST(Cycle, InterruptEndsTheCallAfterThatCycleWithInterrupted) {
-  auto make = [] {
-    Simulation sim = random_box(200, 3);
-    sim.settings.gravity = {0, 0, -9.81};
-    sim.settings.local_damping = 0.7;
-    sim.make_wet(20e3, 1e-3);
-    return sim;
-  };
-  Simulation hooked = make(), plain = make();
+  Simulation hooked = wet_damped_box(), plain = wet_damped_box();
   int asked = 0;
   hooked.interrupt = [&] { return ++asked == 37; };
   try {

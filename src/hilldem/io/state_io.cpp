@@ -388,7 +388,7 @@ void write_simulation(CheckpointWriter& w, const Simulation& sim) {
     balls.for_each_column([&](auto& col) { put_column(s, col); });
   }
   if (!sim.clumps.empty()) {
-    // (Only with clumps: a checkpoint without them is as before, and reads in builds before them.)
+    // (Only with clumps: a checkpoint without clumps has no such section, and builds without clumps read it.)
     SectionWriter& s = w.section("sim.clumps");
     auto& clumps = const_cast<ClumpBodies&>(sim.clumps);  // for_each_column is non-const; only read here
     std::uint32_t columns = 0;
