@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "hilldem/core/error.hpp"
+#include "hilldem/io/state_io.hpp"
 #include "hilldem/labtests/t307.hpp"
 #include "mini_specimen.hpp"
 
@@ -64,6 +65,34 @@ TEST(T307Driver, SequencesFollowTheTargetAndGivePositiveModuli) {
   // The test leaves no controller behind and the walls at rest.
   EXPECT_TRUE(s.sim.controllers.empty());
   EXPECT_EQ(s.sim.walls.walls[s.vessel.top].velocity.z, 0.0);
+}
+
+// The driver reads only the walls and the clock between cycles, so Simulation::drive writes the
+// results of one cycle per settle and per pulse: the same bits as a run in which a no-op observer
+// makes every cycle write everything (as cycle(1) after each cycle did).
+TEST(T307Driver, DrivenCyclesGiveTheResultsOfWatchedCycles) {
+  Specimen driven = testing::mini_packed();
+  finalize(driven, Class5Material{}, WallContact{}, EquilibriumSettings{}, nullptr);
+  Specimen watched = driven;
+  watched.sim.observers.push_back([](const Simulation&) {});
+  T307Settings t = mini_settings();
+  t.sequences.resize(3);
+  t.timing.cycles = 2;
+  t.timing.averaged_cycles = 1;
+  const std::int64_t passes_driven = driven.sim.live_record_passes(), passes_watched = watched.sim.live_record_passes();
+  const T307Result a = run_t307(driven, t, nullptr);
+  const T307Result b = run_t307(watched, t, nullptr);
+  EXPECT_EQ(a.steps, b.steps);
+  EXPECT_EQ(a.cycles_csv(), b.cycles_csv());
+  EXPECT_EQ(a.sequences_csv(), b.sequences_csv());
+  ASSERT_EQ(a.cycles.size(), b.cycles.size());
+  for (std::size_t k = 0; k < a.cycles.size(); ++k) {
+    EXPECT_EQ(a.cycles[k].q_peak, b.cycles[k].q_peak);
+    EXPECT_EQ(a.cycles[k].eps_a_end, b.cycles[k].eps_a_end);
+  }
+  EXPECT_EQ(state_digest(driven.sim), state_digest(watched.sim));
+  EXPECT_GT(driven.sim.live_record_passes() - passes_driven, a.steps / 2);
+  EXPECT_EQ(watched.sim.live_record_passes(), passes_watched);  // (a watched cycle never runs them)
 }
 
 // The standard's stop: past the permanent strain limit, no later sequence runs and no fit is made.

@@ -10,6 +10,7 @@
 #include <random>
 
 #include "hilldem/core/error.hpp"
+#include "hilldem/io/state_io.hpp"
 #include "hilldem/labtests/specimen_io.hpp"
 #include "hilldem/labtests/study.hpp"
 #include "hilldem/labtests/triaxial.hpp"
@@ -254,6 +255,41 @@ TEST(Triaxial, MiniatureTestRunsTheCyclesAndComputesTheModuli) {
   // Quasi-static: the platens carry the same force.
   EXPECT_LT(r.worst_platen_mismatch, 0.05);
   for (const TriaxialRow& row : r.history) EXPECT_LE(row.platen_mismatch, r.worst_platen_mismatch + 1e-15);
+}
+
+// The lab drivers step the engine through Simulation::drive, which writes the results only of the
+// cycles after which they read the specimen. A no-op observer makes every cycle write everything,
+// as cycle(1) after each cycle did: finalization (servo_equilibrium) and the test must give the same
+// bits either way, every history row (its porosity and coordination read the contacts) included.
+TEST(Triaxial, DrivenCyclesGiveTheResultsOfWatchedCycles) {
+  Specimen driven = testing::mini_packed();
+  Specimen watched = testing::mini_packed();
+  int observed = 0;
+  watched.sim.observers.push_back([&observed](const Simulation&) { ++observed; });
+  finalize(driven, Class5Material{}, WallContact{}, EquilibriumSettings{}, nullptr);
+  finalize(watched, Class5Material{}, WallContact{}, EquilibriumSettings{}, nullptr);
+  EXPECT_EQ(observed, watched.sim.steps - testing::mini_packed().sim.steps);
+  EXPECT_EQ(state_digest(driven.sim), state_digest(watched.sim));
+  const std::int64_t passes_driven = driven.sim.live_record_passes(), passes_watched = watched.sim.live_record_passes();
+  const TriaxialResult a = run_triaxial(driven, mini_test(), nullptr);
+  const TriaxialResult b = run_triaxial(watched, mini_test(), nullptr);
+  EXPECT_EQ(a.steps, b.steps);
+  EXPECT_EQ(a.history_csv(), b.history_csv());  // every value printed to 9 digits, the step of every row
+  ASSERT_EQ(a.history.size(), b.history.size());
+  for (std::size_t k = 0; k < a.history.size(); ++k) {
+    SCOPED_TRACE(k);
+    EXPECT_EQ(a.history[k].step, b.history[k].step);
+    EXPECT_EQ(a.history[k].q, b.history[k].q);
+    EXPECT_EQ(a.history[k].porosity, b.history[k].porosity);
+    EXPECT_EQ(a.history[k].coordination, b.history[k].coordination);
+  }
+  EXPECT_EQ(a.loops_text(), b.loops_text());
+  EXPECT_EQ(a.peak_q, b.peak_q);
+  EXPECT_EQ(state_digest(driven.sim), state_digest(watched.sim));
+  // Unwatched cycles ran: the engine's live records served most force passes of the driven test.
+  EXPECT_GT(driven.sim.live_record_passes() - passes_driven, a.steps / 2);
+  EXPECT_EQ(watched.sim.live_record_passes(), passes_watched);  // (a watched cycle never runs them)
+  EXPECT_TRUE(driven.sim.controllers.empty());
 }
 
 // Density scaling: about F times fewer steps, the same moduli (the half-size C5b study specimen

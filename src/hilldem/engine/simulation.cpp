@@ -39,6 +39,22 @@ std::int64_t Simulation::cycle(std::int64_t n, const std::function<bool()>& stop
   return n;
 }
 
+std::int64_t Simulation::drive(std::int64_t n, const std::function<bool(double)>& plan) {
+  drop_records();  // the caller may have changed the columns since the last call
+  for (std::int64_t k = 0; k < n; ++k) {
+    const bool interrupted = interrupt && interrupt();
+    steps_ahead_ = n - 1 - k;  // (at most: plan may end the call sooner)
+    const bool last = step_once(k + 1 == n || interrupted, &plan);
+    if (interrupted) throw_interrupted();
+    if (last) {
+      steps_ahead_ = 0;
+      return k + 1;
+    }
+  }
+  steps_ahead_ = 0;
+  return n;
+}
+
 std::int64_t Simulation::solve(double ratio, std::int64_t max_steps) {
   // At least one cycle: forces may be stale (make_wet changes them only on the next cycle, §2.7).
   drop_records();
@@ -84,9 +100,9 @@ double Simulation::skin() const {
   return 0.1 * 2.0 * sum / static_cast<double>(balls.size());
 }
 
-void Simulation::step_once(bool last) {
+bool Simulation::step_once(bool last, const std::function<bool(double)>* plan) {
   try {
-    step_body(last);
+    return step_body(last, plan);
   } catch (...) {
     sync_ball_columns();  // the state where the run stopped, for whoever catches this
     if (live_.records_ready()) live_.sync_records(contacts);
@@ -94,14 +110,15 @@ void Simulation::step_once(bool last) {
   }
 }
 
-void Simulation::step_body(bool last) {
+bool Simulation::step_body(bool last, const std::function<bool(double)>* plan) {
+  apply_thread_budget();  // when several simulations share the cores (engine/thread_budget.hpp)
+  if (!forces_ready_) update_forces();
+  const double dt = next_timestep();
+  if (plan && (*plan)(dt)) last = true;  // (it sets walls only: the records stay)
   // The reported results of ball-ball contacts, and the balls' columns, only when someone may read
   // them (see cycle()).
   const bool watched = last || !observers.empty() || !controllers.empty();
   write_results_ = watched;
-  apply_thread_budget();  // when several simulations share the cores (engine/thread_budget.hpp)
-  if (!forces_ready_) update_forces();
-  const double dt = next_timestep();
   if (!controllers.empty()) drop_records();  // they may set the columns' velocities
   for (const auto& control : controllers) control(*this, dt);  // servos set wall velocities
   const double* m_scaled = nullptr;
@@ -136,6 +153,7 @@ void Simulation::step_body(bool last) {
   ++steps;
   last_dt = dt;
   for (const auto& obs : observers) obs(*this);
+  return last;
 }
 
 void Simulation::advance_with_clumps(double dt) {

@@ -73,7 +73,9 @@ class Simulation {
   // Called after every cycle (histories, progress).
   std::vector<std::function<void(const Simulation&)>> observers;
   // Called at the start of every cycle with its Δt [s], before the law of motion, with the forces
-  // at t: servos and other controllers set wall or ball velocities here.
+  // at t: servos and other controllers set wall or ball velocities here. While any is registered
+  // every cycle writes its results (a controller may read them); servos that read and set only walls
+  // run in the plan of drive() instead, as the lab tests' do.
   std::vector<std::function<void(Simulation&, double)>> controllers;
   // The domain decomposition this Simulation is one rank's part of, or null (see DomainHooks).
   DomainHooks* domain = nullptr;
@@ -91,6 +93,18 @@ class Simulation {
   // bitwise that of cycle(k), so a caller can answer an interruption (the Python module: Ctrl-C)
   // without cutting a long run into many calls, each of which rebuilds the cycle's records.
   std::int64_t cycle(std::int64_t n, const std::function<bool()>& stop);
+  // Up to n cycles for a driver that decides between cycles on what the walls and the clock say:
+  // the lab tests' servo loops (PFC's servo FISH functions). Before each cycle's law of motion,
+  // with the forces at t, plan(dt) is called with that cycle's Δt [s]: it may set the walls'
+  // velocities (as a controller does) and read the walls (position, force sums), time and steps,
+  // nothing else (the balls' columns and the contacts' reported results are those of the last
+  // cycle that wrote them); it returns true when this cycle must be the call's last, the one whose
+  // results are written as at the end of cycle(k). The cycles in between run as within cycle(n),
+  // unwatched, unless observers or controllers are registered. Returns the cycles run. A driver
+  // that needs the specimen's contacts after some cycle plans that cycle as the last: the
+  // same bits as cycle(1) after each, at the cost of the cycles that write everything
+  // (docs/lab-tests.md, "Where the time goes").
+  std::int64_t drive(std::int64_t n, const std::function<bool(double dt)>& plan);
   // Cycle (at least once) until the mean unbalanced-force ratio is ≤ ratio; returns the cycles
   // used, or -1 if max_steps passed first. (Every cycle's contact results are written.)
   std::int64_t solve(double ratio, std::int64_t max_steps);
@@ -177,8 +191,9 @@ class Simulation {
  private:
   [[noreturn]] void throw_interrupted() const;
   // One cycle; `last`: the last of a cycle() call (its contact results are written).
-  void step_once(bool last);
-  void step_body(bool last);  // step_once's work (step_once syncs the columns if it throws)
+  // One cycle; `plan` (drive()) may make it the last. Returns whether it was.
+  bool step_once(bool last, const std::function<bool(double)>* plan = nullptr);
+  bool step_body(bool last, const std::function<bool(double)>* plan);  // step_once's work (step_once syncs the columns if it throws)
   // §1.2 steps 1-2 with clumps: the balls on the columns, then the clumps, which place their pebbles.
   void advance_with_clumps(double dt);
   void rebuild(double reach);

@@ -332,12 +332,14 @@ PhaseReport servo_equilibrium(Specimen& s, const EquilibriumSettings& e, const s
   const auto t0 = std::chrono::steady_clock::now();
   Simulation& sim = s.sim;
   const ServoSettings ss{e.pressure, e.servo_gain, e.wall_speed_limit};
-  auto servos = std::make_shared<std::vector<Servo>>(
-      std::vector<Servo>{s.vessel.radial_servo(ss), s.vessel.platen_servo(false, ss), s.vessel.platen_servo(true, ss)});
-  ControllerScope scope(sim);
-  sim.controllers.push_back([servos](Simulation& m, double dt) {
-    for (Servo& sv : *servos) sv.control(m, dt);
-  });
+  std::vector<Servo> servos{s.vessel.radial_servo(ss), s.vessel.platen_servo(false, ss), s.vessel.platen_servo(true, ss)};
+  // The servos read and move only the walls: every cycle but the last of each check runs unwatched
+  // (Simulation::drive).
+  const std::int64_t check_every = std::max<std::int64_t>(1, e.check_every);
+  auto plan = [&](double dt) {
+    for (Servo& sv : servos) sv.control(sim, dt);
+    return false;
+  };
   const std::int64_t start = sim.steps;
   const std::int64_t progress_every = 20000;
   std::int64_t next_progress = start + progress_every;
@@ -348,7 +350,7 @@ PhaseReport servo_equilibrium(Specimen& s, const EquilibriumSettings& e, const s
   PorosityHistory history(e.porosity_window);
   history.add(sim.steps, porosity());
   for (;;) {
-    sim.cycle(std::max<std::int64_t>(1, e.check_every));
+    sim.drive(check_every, plan);
     history.add(sim.steps, porosity());
     const double sr = s.vessel.radial_stress(sim), sb = s.vessel.bottom_stress(sim), st = s.vessel.top_stress(sim);
     if (within(sr) && within(sb) && within(st) && sim.mean_unbalanced_ratio() <= e.ratio && history.converged(e.porosity_change))

@@ -6,11 +6,9 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <memory>
 #include <numbers>
 #include <ostream>
 
-#include "hilldem/control/controller_scope.hpp"
 #include "hilldem/core/error.hpp"
 
 namespace hilldem {
@@ -52,28 +50,45 @@ T307Result run_t307(Specimen& s, const T307Settings& t, std::ostream* log) {
     double pulse_start = std::numeric_limits<double>::infinity();  // no pulse
     double axial = 0.0;  // the axial target at the end of the coming step [Pa]
   };
-  auto targets = std::make_shared<Targets>();
+  Targets targets;
   const ServoSettings ss{t.sequences.front().confining, tm.servo_gain, tm.wall_speed_limit};
-  auto radial = std::make_shared<Servo>(v.radial_servo(ss));
-  auto axial = std::make_shared<Servo>(v.platen_servo(true, ss));
-  ControllerScope scope(sim);
+  Servo radial = v.radial_servo(ss);
+  Servo axial = v.platen_servo(true, ss);
   const double pulse = tm.pulse_duration;
-  sim.controllers.push_back([radial, axial, targets, pulse](Simulation& m, double dt) {
+  auto control = [&](double dt) {
     // The target at t + Δt: the wall velocity set now acts over the coming step.
-    targets->axial = targets->axial_base + targets->cyclic * haversine(m.time + dt - targets->pulse_start, pulse);
-    radial->settings.target_stress = targets->radial;
-    axial->settings.target_stress = targets->axial;
-    radial->control(m, dt);
-    axial->control(m, dt);
-  });
+    targets.axial = targets.axial_base + targets.cyclic * haversine(sim.time + dt - targets.pulse_start, pulse);
+    radial.settings.target_stress = targets.radial;
+    axial.settings.target_stress = targets.axial;
+    radial.control(sim, dt);
+    axial.control(sim, dt);
+  };
   auto eps_a = [&] { return (h0 - v.height(sim)) / h0; };
   auto eps_r = [&] { return (r0 - v.radius(sim)) / r0; };
-  auto step = [&] {
-    sim.cycle(1);
+  auto check_limit = [&] {
     if (sim.steps - step0 >= t.max_steps) {
       v.stop(sim);
       throw RunError(fmt::format("T 307: not finished within {} steps", t.max_steps));
     }
+  };
+  // Cycles until `duration` [s] has passed since `start` (at least one), calling after() at the end of
+  // each with what the walls say. Through Simulation::drive: the servos are set in its plan, and only
+  // the last cycle writes its results. The time after a cycle is time + Δt, the same addition as
+  // the engine's, so the last cycle is known before it runs (and the test reads only walls and the
+  // clock: the same bits as cycle(1) after each cycle).
+  auto run_for = [&](double start, double duration, const auto& after) {
+    bool pending = false;  // a cycle ran whose end after() has not seen
+    do {
+      sim.drive(t.max_steps, [&](double dt) {
+        if (pending) after(), check_limit();
+        pending = true;
+        control(dt);
+        return !(sim.time + dt - start < duration) || sim.steps + 1 - step0 >= t.max_steps;
+      });
+      pending = false;
+      after();
+      check_limit();
+    } while (sim.time - start < duration);
   };
   if (log)
     *log << fmt::format("t307: H0 {:.2f} mm, R0 {:.2f} mm; pulse {:g} s, rest {:g} s, settle {:g} s, {} cycles per sequence "
@@ -87,12 +102,10 @@ T307Result run_t307(Specimen& s, const T307Settings& t, std::ostream* log) {
     const int n = seq.number == 0 ? tm.conditioning_cycles : tm.cycles;
     if (n == 0) continue;
     const std::int64_t seq_step0 = sim.steps;
-    targets->radial = seq.confining;
-    targets->axial_base = seq.confining + seq.contact;
-    targets->pulse_start = std::numeric_limits<double>::infinity();
-    const double settle0 = sim.time;
-    do step();
-    while (sim.time - settle0 < tm.settle_duration);
+    targets.radial = seq.confining;
+    targets.axial_base = seq.confining + seq.contact;
+    targets.pulse_start = std::numeric_limits<double>::infinity();
+    run_for(sim.time, tm.settle_duration, [] {});
     const double eps_start = eps_a();
     if (seq.number != 0 && std::isnan(eps_first)) eps_first = eps_start;
     double gain = 1.0;  // commanded / target pulse amplitude, from 1 at each sequence's first cycle
@@ -102,16 +115,15 @@ T307Result run_t307(Specimen& s, const T307Settings& t, std::ostream* log) {
     for (int c = 1; c <= n; ++c) {
       T307Cycle cy;
       cy.sequence = seq.number, cy.cycle = c;
-      cy.command = targets->cyclic = gain * seq.cyclic;
-      targets->pulse_start = sim.time;
+      cy.command = targets.cyclic = gain * seq.cyclic;
+      targets.pulse_start = sim.time;
       double eps_max = -std::numeric_limits<double>::infinity(), eps_r_at_max = 0.0;
       cy.q_peak = -std::numeric_limits<double>::infinity();
-      do {
-        step();
+      run_for(targets.pulse_start, tm.pulse_duration + tm.rest_duration, [&] {
         const double sig_r = v.radial_stress(sim), q = v.axial_stress(sim) - sig_r, ea = eps_a();
         if (q > cy.q_peak) cy.q_peak = q, cy.sigma_r_peak = sig_r;
         if (ea > eps_max) eps_max = ea, eps_r_at_max = eps_r();
-      } while (sim.time - targets->pulse_start < tm.pulse_duration + tm.rest_duration);
+      });
       cy.q_end = v.axial_stress(sim) - v.radial_stress(sim);
       cy.eps_a_end = eps_a();
       cy.recoverable_axial = eps_max - cy.eps_a_end;

@@ -8,8 +8,8 @@
 #include <memory>
 #include <numbers>
 #include <ostream>
+#include <stdexcept>
 
-#include "hilldem/control/controller_scope.hpp"
 #include "hilldem/core/error.hpp"
 
 namespace hilldem {
@@ -163,14 +163,8 @@ TriaxialResult run_triaxial(Specimen& s, const TriaxialSettings& t, std::ostream
                                  t.density_scaling);
   }
 
-  auto servo = std::make_shared<Servo>(v.radial_servo(ServoSettings{t.confinement, t.servo_gain, t.wall_speed_limit}));
-  auto closing = std::make_shared<double>(0.0);  // each platen's speed towards the other [m/s]
-  ControllerScope scope(sim);
-  sim.controllers.push_back([servo, closing, v](Simulation& m, double dt) {
-    servo->control(m, dt);
-    m.walls.walls[v.top].velocity = Vec3{0, 0, -*closing};
-    m.walls.walls[v.bottom].velocity = Vec3{0, 0, *closing};
-  });
+  Servo servo = v.radial_servo(ServoSettings{t.confinement, t.servo_gain, t.wall_speed_limit});
+  double closing = 0.0;  // each platen's speed towards the other [m/s]
 
   const std::size_t n_cycles = t.cycle_strains.size();
   TriaxialPhase phase = n_cycles > 0 ? TriaxialPhase::Load : TriaxialPhase::Final;
@@ -222,10 +216,34 @@ TriaxialResult run_triaxial(Specimen& s, const TriaxialSettings& t, std::ostream
   record(row_now(phase, n_cycles > 0 ? 1 : 0));  // the initial state
   tracker.add(phase, 1, res.history.back().eps_a, res.history.back().q);
 
-  for (;;) {
-    const double rate = phase == TriaxialPhase::Final ? t.final_strain_rate : t.strain_rate;
-    *closing = (phase == TriaxialPhase::Unload ? -0.5 : 0.5) * rate * h0;
-    sim.cycle(1);
+  // The cycles run through Simulation::drive: the servo and the platens are set in its plan, and
+  // a cycle after which the test may record a row (its porosity and coordination read the
+  // contacts) or change phase is planned as the call's last, so that its results are written. The
+  // strain conditions are predicted from the platens' speed over the coming Δt, within a slack far
+  // above the rounding (1e-16) and far below any threshold (≥ 1e-7 here); the unload's end, decided
+  // on q, is not predicted: every unload cycle is written. So every row and decision is made on the
+  // state that cycle(1) after each cycle gives, bit for bit (test
+  // Triaxial.DrivenCyclesGiveTheResultsOfWatchedCycles); the other cycles skip writing what nobody reads.
+  constexpr double kStrainSlack = 1e-12;  // [-]
+  auto may_need_results = [&](double dt) {
+    if (force_record || phase == TriaxialPhase::Unload || sim.steps + 1 - step0 >= t.max_steps) return true;
+    const double h = v.height(sim);
+    const double eps_next = (h0 - (h - 2.0 * closing * dt)) / h0;  // closing ≥ 0 outside the unload
+    const double rec = phase == TriaxialPhase::Final ? final_rec : cycle_rec;
+    if (std::abs(eps_next - last_rec_eps) >= rec - kStrainSlack) return true;
+    const double limit = phase == TriaxialPhase::Load     ? t.cycle_strains[k]
+                         : phase == TriaxialPhase::Reload ? eps_rev
+                                                          : t.final_strain;
+    return eps_next >= limit - kStrainSlack;
+  };
+  // The end of a cycle: its row, the peaks, the records and the phase; true when the test is over.
+  // `written`: the cycle's results were written (drive's last); one that was not cannot need them.
+  auto after_cycle = [&](bool written) {
+    auto need = [&](const char* what) {
+      if (!written)
+        throw std::logic_error(fmt::format("triaxial test: {} at step {} after a cycle that was not planned to write its results",
+                                           what, sim.steps - step0));
+    };
     const int cycle = phase == TriaxialPhase::Final ? 0 : static_cast<int>(k) + 1;
     const TriaxialRow r = row_now(phase, cycle);
     const double conf_err = std::abs(r.sigma_r - t.confinement) / t.confinement;
@@ -235,7 +253,10 @@ TriaxialResult run_triaxial(Specimen& s, const TriaxialSettings& t, std::ostream
       res.peak_q = r.q, res.peak_strain = r.eps_a, res.peak_radial_strain = r.eps_r, res.peak_volumetric_strain = r.eps_v;
     tracker.add(phase, cycle, r.eps_a, r.q);
     const double rec = phase == TriaxialPhase::Final ? final_rec : cycle_rec;
-    if (force_record || std::abs(r.eps_a - last_rec_eps) >= rec) record(r);
+    if (force_record || std::abs(r.eps_a - last_rec_eps) >= rec) {
+      need("a row to record");
+      record(r);
+    }
     force_record = false;
 
     if (log && r.step % 20000 == 0) {
@@ -254,10 +275,12 @@ TriaxialResult run_triaxial(Specimen& s, const TriaxialSettings& t, std::ostream
       ++k;
       next = k < n_cycles ? TriaxialPhase::Load : TriaxialPhase::Final;
     } else if (phase == TriaxialPhase::Final && r.eps_a >= t.final_strain) {
+      need("the final strain");
       if (res.history.back().step != r.step) record(r);
-      break;
+      return true;
     }
     if (next != phase) {
+      need("a phase change");
       if (res.history.back().step != r.step) record(r);
       force_record = true;
       if (log)
@@ -267,10 +290,27 @@ TriaxialResult run_triaxial(Specimen& s, const TriaxialSettings& t, std::ostream
       phase = next;
     }
     if (sim.steps - step0 >= t.max_steps) {
+      need("the step limit");
       v.stop(sim);
       throw RunError(fmt::format("triaxial test: final strain {:g} % not reached within {} steps (at {:.4f} %)",
                                  100 * t.final_strain, t.max_steps, 100 * r.eps_a));
     }
+    return false;
+  };
+  bool pending = false;  // a cycle ran whose end after_cycle has not seen
+  for (bool done = false; !done;) {
+    sim.drive(t.max_steps, [&](double dt) {
+      if (pending) after_cycle(false);  // (it cannot end the test: may_need_results planned that cycle as the last)
+      pending = true;
+      const double rate = phase == TriaxialPhase::Final ? t.final_strain_rate : t.strain_rate;
+      closing = (phase == TriaxialPhase::Unload ? -0.5 : 0.5) * rate * h0;
+      servo.control(sim, dt);
+      sim.walls.walls[v.top].velocity = Vec3{0, 0, -closing};
+      sim.walls.walls[v.bottom].velocity = Vec3{0, 0, closing};
+      return may_need_results(dt);
+    });
+    pending = false;
+    done = after_cycle(true);
   }
   v.stop(sim);
   res.loops = tracker.loops();
