@@ -232,7 +232,9 @@ TriangleMesh closed_mesh(TriangleMesh m, const std::string& source) {
       edges[{std::min(i, j), std::max(i, j)}].emplace_back(static_cast<int>(t), i < j ? 1 : -1);
     }
   }
-  for (const auto& [e, users] : edges) {
+  for (const auto& entry : edges) {
+    const std::pair<int, int>& e = entry.first;  // (not a structured binding: lambdas capture it in C++20 only from clang 16)
+    const std::vector<std::pair<int, int>>& users = entry.second;
     const auto where = [&] {
       const Vec3 a = m.vertices[e.first], b = m.vertices[e.second];
       return "triangle " + std::to_string(users[0].first) + ", edge (" + std::to_string(a.x) + ", " + std::to_string(a.y) +
