@@ -45,7 +45,8 @@ Command add_bench_command(CLI::App& app) {
                   "(why a bed whose step data fit in the caches runs faster per particle; docs/performance.md)");
   bench->add_option("--clumps", o->clumps,
                     std::string("each sphere a clump of this template (") + kNamedTemplates +
-                        "), as large as the sphere, randomly oriented; the box not periodic (docs/clumps.md)");
+                        "), as large as the sphere, randomly oriented; or \"pairs\": touching spheres joined into two-pebble "
+                        "clumps, the dense bed; the box not periodic (docs/clumps.md)");
   bench->add_option("--settle", *settle_out,
                     "instead of timing: settle the --data bed under hilldem's laws and write it to this file");
   return {bench, [o, settle_out, memory, caches] {

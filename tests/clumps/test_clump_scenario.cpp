@@ -3,10 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <numbers>
 #include <string>
 
 #include "hilldem/core/error.hpp"
+#include "hilldem/bodies/clump_fill.hpp"
+#include "hilldem/bodies/clump_mesh.hpp"
 #include "hilldem/io/scenario.hpp"
 
 namespace hilldem {
@@ -142,6 +146,55 @@ TEST(ClumpScenario, ErrorsNameTheKey) {
   expect_error(with("name = \"rod\"", "name = \"rod\"\ncolour = 3"), {"colour"});
   std::string egg = kHead + "[[clump_template]]\nname = \"e\"\nmaterial = \"granite\"\nellipsoid = [4e-3, 8e-3, 4e-3]\n";
   expect_error(egg, {"ellipsoid", "a >= b >= c"});
+}
+
+// The shapes: a named polyhedron, the hull of vertices and a mesh file beside the scenario give the
+// fill's pebbles (the unit cube all three ways), scaled by size.
+TEST(ClumpScenario, ShapesAndMeshFiles) {
+  const auto dir = std::filesystem::temp_directory_path() / "hilldem_clump_scenario_mesh";
+  std::filesystem::create_directories(dir / "shapes");
+  {
+    std::ofstream obj(dir / "shapes" / "cube.obj");
+    obj << "v -0.5 -0.5 -0.5\nv 0.5 -0.5 -0.5\nv -0.5 0.5 -0.5\nv 0.5 0.5 -0.5\n"
+           "v -0.5 -0.5 0.5\nv 0.5 -0.5 0.5\nv -0.5 0.5 0.5\nv 0.5 0.5 0.5\n"
+           "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n";
+  }
+  const std::string shape_keys = "count = 6\nsmallest_ratio = 0.4\nsize = 8e-3\n";
+  const std::string text = kHead + "[[clump_template]]\nname = \"a\"\nmaterial = \"granite\"\npolyhedron = \"cube\"\n" + shape_keys +
+                           "[[clump_template]]\nname = \"b\"\nmaterial = \"granite\"\nmesh = \"shapes/cube.obj\"\n" + shape_keys +
+                           "[[clump_template]]\nname = \"c\"\nmaterial = \"granite\"\nvertices = [[-0.5, -0.5, -0.5], [0.5, -0.5, -0.5], "
+                           "[-0.5, 0.5, -0.5], [0.5, 0.5, -0.5], [-0.5, -0.5, 0.5], [0.5, -0.5, 0.5], [-0.5, 0.5, 0.5], [0.5, 0.5, 0.5]]\n" +
+                           shape_keys;
+  std::string clumps;
+  for (int j = 0; j < 3; ++j)
+    clumps += "[[clump]]\ntemplate = \"" + std::string(1, static_cast<char>('a' + j)) + "\"\nfirst_id = " + std::to_string(10 * (j + 1)) +
+              "\nposition = [0.0, " + std::to_string(0.03 * (j + 1)) + ", 0.0]\n";
+  const Scenario sc = load_scenario(text + clumps, (dir / "case.toml").string());
+  FillParams f;
+  f.count = 6;
+  f.smallest_ratio = 0.4;
+  const ClumpTemplate expect = make_template(fill_shape(MeshShape(aggregate_polyhedron("cube")), f).pebbles, 2650.0).scaled(8e-3);
+  ASSERT_EQ(expect.pebbles.size(), 6u);
+  const ClumpPebbles& p = sc.sim.clumps.pebbles;
+  ASSERT_EQ(sc.sim.clumps.size(), 3u);
+  ASSERT_EQ(p.size(), 18u);
+  EXPECT_EQ(sc.sim.balls.size(), 1u + 18u);
+  // (each pebble's distance from the centre of mass and its radius: the cube's fill is nearly
+  // isotropic, so the principal frame is not compared)
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    EXPECT_NEAR(norm(p.body_position[k]), norm(expect.pebbles.position[k % 6]), 1e-15) << k;
+    EXPECT_NEAR(p.radius[k], expect.pebbles.radius[k % 6], 1e-15) << k;
+  }
+  EXPECT_NEAR(sc.sim.clumps.state.mass[1], 2650.0 * std::numbers::pi / 6 * 512e-9, 1e-12 * expect.mass);
+  // errors name the key and the file
+  const std::string bad = kHead + "[[clump_template]]\nname = \"m\"\nmaterial = \"granite\"\nmesh = \"shapes/none.stl\"\n";
+  expect_error(bad, {"mesh", "none.stl", "cannot open"});
+  const std::string two = kHead + "[[clump_template]]\nname = \"m\"\nmaterial = \"granite\"\npolyhedron = \"cube\"\nellipsoid = [1.0, 1.0, 1.0]\n";
+  expect_error(two, {"exactly one of"});
+  const std::string name = kHead + "[[clump_template]]\nname = \"m\"\nmaterial = \"granite\"\npolyhedron = \"sphere\"\n";
+  expect_error(name, {"polyhedron", "rock"});
+  const std::string fid = kHead + "[[clump_template]]\nname = \"m\"\nmaterial = \"granite\"\npolyhedron = \"cube\"\nfidelity = 1.5\n";
+  expect_error(fid, {"fidelity", "(0, 1]"});
 }
 
 }  // namespace

@@ -78,6 +78,14 @@ TEST(ClumpTemplate, OnePebbleIsTheSphereExactly) {
   EXPECT_NEAR(t.centre_of_mass.x, 1e-3, 1e-18);
   EXPECT_NEAR(norm(t.pebbles.position[0]), 0.0, 1e-18);
   EXPECT_NEAR(t.equal_volume_diameter(), 2 * r, 1e-15);
+  // Isotropic to the bit at any radius and scale, so that its clumps take the ball's spin update.
+  for (const double radius : {1.0, 0.3, 2.5e-3, 4e-3, 4.37e-3, 5.1e-3}) {
+    const ClumpTemplate u = make_template({{{0.2, -0.1, 0.05}}, {radius}}, rho);
+    for (const ClumpTemplate& v : {u, u.scaled(8.74e-3, SizeMeasure::EnclosingDiameter), u.scaled(1.02e-2)}) {
+      EXPECT_EQ(v.principal_inertia.x, v.principal_inertia.y) << radius;
+      EXPECT_EQ(v.principal_inertia.y, v.principal_inertia.z) << radius;
+    }
+  }
 }
 
 TEST(ClumpTemplate, TwoOverlappingPebblesMatchTheLensByQuadrature) {

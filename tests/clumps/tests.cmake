@@ -5,6 +5,8 @@ add_executable(hilldem_clump_tests
   clumps/test_clump_template.cpp
   clumps/test_rigid_body.cpp
   clumps/test_clump_shapes.cpp
+  clumps/test_clump_fill.cpp
+  clumps/test_clump_bed.cpp
   clumps/test_clump_pebbles.cpp
   clumps/test_clump_engine.cpp
   clumps/test_clump_scenario.cpp

@@ -1,5 +1,6 @@
 #include "hilldem/bench/bed_bench.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <numbers>
@@ -98,6 +99,66 @@ Simulation make_clump_bed(const Packing& packing, const ClumpTemplate& unit, std
   return sim;
 }
 
+Simulation make_pair_bed(const Packing& packing) {
+  Simulation spheres = make_bed(packing);
+  spheres.cycle(1);  // the settled bed's contacts
+  const std::size_t n = spheres.balls.size();
+  // Per ball, its touching partners (overlap, partner), from the active ball-ball rows; a pair across
+  // a periodic boundary is left out (the clump bed is not periodic).
+  std::vector<std::vector<std::pair<double, std::uint32_t>>> partners(n);
+  for (std::size_t c = 0; c < spheres.contacts.size(); ++c) {
+    const ContactKey& k = spheres.contacts.key[c];
+    if (!spheres.contacts.active[c] || k.kind != ContactKind::BallBall) continue;
+    const double d = norm(spheres.balls.position[k.a] - spheres.balls.position[k.b]);
+    const double overlap = spheres.balls.radius[k.a] + spheres.balls.radius[k.b] - d;
+    if (overlap < 0.0 || overlap > 0.5 * std::min(spheres.balls.radius[k.a], spheres.balls.radius[k.b])) continue;
+    partners[k.a].emplace_back(overlap, static_cast<std::uint32_t>(k.b));
+    partners[k.b].emplace_back(overlap, static_cast<std::uint32_t>(k.a));
+  }
+  // Greedy matching in bed order: each ball not yet taken takes its free partner of largest overlap
+  // (ties: the lower row), or stays alone (a one-pebble clump).
+  std::vector<std::int64_t> mate(n, -1);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (mate[i] >= 0) continue;
+    std::sort(partners[i].begin(), partners[i].end(),
+              [](const auto& x, const auto& y) { return x.first != y.first ? x.first > y.first : x.second < y.second; });
+    for (const auto& [overlap, j] : partners[i])
+      if (mate[j] < 0 && j != i) {
+        mate[i] = j;
+        mate[j] = static_cast<std::int64_t>(i);
+        break;
+      }
+  }
+  Simulation sim;
+  sim.settings = spheres.settings;
+  sim.settings.box = PeriodicBox{};
+  sim.table = spheres.table;
+  sim.walls = spheres.walls;
+  std::int64_t id = 1;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (mate[i] >= 0 && static_cast<std::size_t>(mate[i]) < i) continue;  // (made with its mate)
+    Pebbles p;
+    p.position.push_back(spheres.balls.position[i]);
+    p.radius.push_back(spheres.balls.radius[i]);
+    if (mate[i] >= 0) {
+      p.position.push_back(spheres.balls.position[mate[i]]);
+      p.radius.push_back(spheres.balls.radius[mate[i]]);
+    }
+    // Exact mass properties (one or two pebbles); the clump placed where its pebbles were given.
+    const ClumpTemplate t = make_template(p, spheres.balls.density[i]);
+    ClumpInit c;
+    c.first_ball_id = id;
+    c.position = t.centre_of_mass;
+    // (orientation: identity; add_clump turns the principal frame by the template's own)
+    c.young_mod = spheres.balls.young_mod[i];
+    c.pois_ratio = spheres.balls.pois_ratio[i];
+    sim.clumps.add(sim.balls, t, c);
+    id += static_cast<std::int64_t>(p.size());
+  }
+  sim.invalidate_forces();
+  return sim;
+}
+
 std::int64_t settle_bed(const std::string& in, const std::string& out, double ratio) {
   Packing packing = read_packing(in, PackingFormat::Lammps);
   Simulation sim = make_bed(packing);
@@ -120,8 +181,9 @@ BedBenchResult run_bed_bench(const BedBenchOptions& o, const BenchDecomposition*
   replicate(packing, rep);
   if (dec && !o.clumps.empty())
     throw InputError("bench --clumps: clumps are not decomposed over MPI ranks yet (docs/mpi.md); run it on one rank");
-  Simulation sim = o.clumps.empty() ? make_bed(packing)
-                                    : make_clump_bed(packing, named_template(o.clumps, 2650.0), 10000);
+  Simulation sim = o.clumps.empty()    ? make_bed(packing)
+                   : o.clumps == "pairs" ? make_pair_bed(packing)
+                                         : make_clump_bed(packing, named_template(o.clumps, 2650.0), 10000);
   if (o.block > 0) sim.balls_per_block = o.block;
   if (dec) dec->attach(sim);
   sim.cycle(o.warmup);

@@ -26,7 +26,8 @@ struct BedBenchOptions {
   // A named clump template (bodies/clump_shapes.hpp, named_template): each sphere of the bed becomes a
   // clump of it, scaled to the sphere's diameter as its enclosing diameter (so that its pebbles lie
   // inside the sphere and overlap no more than the spheres did), in a random orientation; the box is
-  // then not periodic (clumps are not supported in one). Empty: the spheres.
+  // then not periodic (clumps are not supported in one). "pairs": the dense bed of make_pair_bed.
+  // Empty: the spheres.
   std::string clumps;
 };
 
@@ -62,6 +63,13 @@ Simulation make_bed(const Packing& packing);
 BedBenchResult run_bed_bench(const BedBenchOptions& options, const BenchDecomposition* decomposition = nullptr);
 // The bed with each sphere a clump of `unit` (see BedBenchOptions::clumps), orientations from `seed`.
 Simulation make_clump_bed(const Packing& packing, const ClumpTemplate& unit, std::uint64_t seed);
+// The dense, settled clump bed: the sphere bed (its contacts after one step) with touching spheres
+// joined into two-pebble clumps, each pebble where its sphere is — greedily in bed order, each free
+// ball with its free partner of largest overlap; a ball left without one is a one-pebble clump. Pairs
+// across the periodic boundary are not joined (the clump bed is not periodic). Each clump's mass
+// properties are exact (two overlapping spheres). The geometry and the contacts between clumps are
+// the sphere bed's; no settling is needed. Deterministic.
+Simulation make_pair_bed(const Packing& packing);
 
 // Settle a bed under hilldem's own contact laws (local damping 0.7, to a mean unbalanced-force
 // ratio of `ratio`) and write it as a LAMMPS data file, so that both codes time the same bed.

@@ -93,7 +93,16 @@ GeometricMoments operator+(const GeometricMoments& a, const GeometricMoments& b)
   return {a.volume + b.volume, a.first + b.first, a.second + b.second};
 }
 
-GeometricMoments sphere_moments(const Vec3& c, double r) { return sphere_slab(c, {0, 0, 1}, r, -r, r); }
+// A whole sphere in closed form: V = 4/3 π r³ and ∫x² dV = ∫y² dV = ∫z² dV = 4/15 π r⁵ about its
+// centre, equal to the bit (the slab integrals along one axis differ from the others in the last
+// bit), so that a one-pebble template has I1 = I2 = I3 exactly and its clumps take the ball's spin
+// update (motion/rigid_body.hpp).
+GeometricMoments sphere_moments(const Vec3& c, double r) {
+  GeometricMoments local;
+  local.volume = 4.0 / 3.0 * kPi * r * r * r;
+  local.second = Mat3::identity() * (4.0 / 15.0 * kPi * std::pow(r, 5));
+  return shifted(local, c);
+}
 
 // Two spheres (r1, r2, centres d apart along e) that intersect, |r1 − r2| < d < r1 + r2, meet on the
 // plane at a = (d² + r1² − r2²)/(2d) from centre 1 (the radical plane). The union is sphere 1 on its

@@ -1,17 +1,28 @@
 #include "hilldem/io/scenario_clumps.hpp"
 
 #include <cmath>
+#include <filesystem>
+#include <memory>
 #include <string>
 
-#include "hilldem/bodies/clump_shapes.hpp"
+#include "hilldem/bodies/clump_fill.hpp"
+#include "hilldem/bodies/clump_mesh.hpp"
 #include "hilldem/core/error.hpp"
 
 namespace hilldem {
 
 ClumpTemplate read_clump_template_shape(TableReader& t, double density) {
-  const bool listed = t.has("centres") || t.has("radii");
-  if (listed == t.has("ellipsoid"))
-    t.fail(listed ? "ellipsoid" : "centres", "needs exactly one of: 'centres' with 'radii' (the pebbles), or 'ellipsoid'");
+  const char* kShapes[] = {"centres", "ellipsoid", "polyhedron", "vertices", "mesh"};
+  int shapes = 0;
+  for (const char* k : kShapes) shapes += t.has(k);
+  if (t.has("radii") && !t.has("centres")) t.fail("radii", "needs 'centres' [m] beside it");
+  if (shapes != 1)
+    t.fail(shapes == 0 ? "centres" : "mesh",
+           "needs exactly one of: 'centres' with 'radii' (the pebbles), or a shape to fill: 'ellipsoid', 'polyhedron', 'vertices' or 'mesh'");
+  const bool listed = t.has("centres");
+  const char* shape_key = "centres";
+  for (const char* k : kShapes)
+    if (t.has(k)) shape_key = k;
   Pebbles p;
   if (listed) {
     p.position = t.vec3_list("centres", "[m]");
@@ -21,13 +32,35 @@ ClumpTemplate read_clump_template_shape(TableReader& t, double density) {
                           std::to_string(p.radius.size()) + " radii)");
     if (p.radius.size() > 10000) t.fail("radii", "at most 10000 pebbles in one template");
   } else {
-    EllipsoidFill f;
-    const Vec3 abc = t.vec3("ellipsoid", std::nullopt, Range::open(0.0, 1e3), "[m] (semi-axes a >= b >= c)");
-    if (!(abc.x >= abc.y && abc.y >= abc.z)) t.fail("ellipsoid", "semi-axes must be ordered a >= b >= c [m]");
-    f.a = abc.x, f.b = abc.y, f.c = abc.z;
-    f.count = static_cast<int>(t.integer("count", 10, 1, 1000));
-    f.smallest_ratio = t.real("smallest_ratio", 0.5, Range::open_closed(0.0, 1.0), "[-]");
-    p = fill_ellipsoid(f);
+    // A shape filled with pebbles (bodies/clump_fill.hpp): the shape, then the fill's parameters.
+    std::unique_ptr<FillShape> shape;
+    try {
+      if (t.has("ellipsoid")) {
+        const Vec3 abc = t.vec3("ellipsoid", std::nullopt, Range::open(0.0, 1e3), "[m] (semi-axes a >= b >= c)");
+        if (!(abc.x >= abc.y && abc.y >= abc.z)) t.fail("ellipsoid", "semi-axes must be ordered a >= b >= c [m]");
+        shape = std::make_unique<EllipsoidShape>(abc.x, abc.y, abc.z);
+      } else if (t.has("polyhedron")) {
+        const std::string name = t.choice("polyhedron", std::nullopt, {"cube", "prism", "slab", "rock"});
+        shape = std::make_unique<MeshShape>(aggregate_polyhedron(name));
+      } else if (t.has("vertices")) {
+        shape = std::make_unique<MeshShape>(convex_hull(t.vec3_list("vertices", "[m]")));
+      } else {
+        const std::filesystem::path file = std::filesystem::path(t.file()).parent_path() / t.string("mesh", std::nullopt);
+        shape = std::make_unique<MeshShape>(read_mesh(file.string()));
+      }
+    } catch (const InputError& e) {
+      t.fail(shape_key, e.what());
+    }
+    FillParams f;
+    f.count = static_cast<int>(t.integer("count", f.count, 1, 1000));
+    f.smallest_ratio = t.real("smallest_ratio", f.smallest_ratio, Range::open_closed(0.0, 1.0), "[-]");
+    f.fidelity = t.real("fidelity", f.fidelity, Range::open_closed(0.0, 1.0), "[-]");
+    f.resolution = static_cast<int>(t.integer("resolution", f.resolution, 9, 301));
+    try {
+      p = fill_shape(*shape, f).pebbles;
+    } catch (const InputError& e) {
+      t.fail(shape_key, e.what());
+    }
   }
   const int columns = static_cast<int>(t.integer("columns", kDefaultColumns, 8, 4096));
   const int user = t.has("volume") + t.has("centre_of_mass") + t.has("inertia");
@@ -50,7 +83,7 @@ ClumpTemplate read_clump_template_shape(TableReader& t, double density) {
       tmpl = make_template(p, density, columns);
     }
   } catch (const InputError& e) {
-    t.fail(listed ? "radii" : "ellipsoid", e.what());
+    t.fail(listed ? "radii" : shape_key, e.what());
   }
   if (t.has("size")) {
     const double size = t.real("size", std::nullopt, Range::open(0.0, 1e3), "[m] (equal-volume diameter)");

@@ -10,7 +10,8 @@
 namespace hilldem {
 
 // The template of a [[clump_template]] table for density ρ [kg/m³]: its pebbles (`centres` and
-// `radii`, or an `ellipsoid` with `count` and `smallest_ratio`), its mass properties (exact for one or
+// `radii`, or a shape filled by bodies/clump_fill.hpp: `ellipsoid`, `polyhedron`, `vertices` or a
+// `mesh` file relative to the scenario, with `count`, `smallest_ratio`, `fidelity`, `resolution`), its mass properties (exact for one or
 // two pebbles, else `columns` of column integration; or the user's `volume`, `centre_of_mass` and
 // `inertia`), scaled to `size` (the equal-volume diameter) when given.
 ClumpTemplate read_clump_template_shape(TableReader& t, double density);
