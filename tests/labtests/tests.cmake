@@ -6,6 +6,7 @@ add_executable(hilldem_labtests_tests
   labtests/test_triaxial.cpp
   labtests/test_measure.cpp
   labtests/test_genesis.cpp
+  labtests/test_clump_specimens.cpp
 )
 target_link_libraries(hilldem_labtests_tests PRIVATE hilldem::core GTest::gtest_main)
 target_compile_definitions(hilldem_labtests_tests PRIVATE HILLDEM_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
