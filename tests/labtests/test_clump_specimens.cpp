@@ -275,5 +275,17 @@ TEST(ClumpGenesis, ASmallClumpSpecimenPacksDeterministicallyAndRunsATriaxialTest
   EXPECT_LT(r.worst_confinement_error, 0.03);
 }
 
+// The study's summary says when a case's grains are clumps.
+TEST(ClumpStudy, TheSummarySaysTheGrainsAreClumps) {
+  StudyResult r;
+  CaseResult c;
+  c.packed_with = GrainModel::Hill;
+  c.clump_template = "elongated2";
+  r.cases.push_back(c);
+  EXPECT_NE(r.summary_markdown().find("| hill (clumps of elongated2) |"), std::string::npos) << r.summary_markdown();
+  r.cases[0].clump_template.clear();
+  EXPECT_EQ(r.summary_markdown().find("clumps of"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace hilldem

@@ -240,7 +240,9 @@ std::string StudyResult::summary_markdown() const {
   std::string out = head + "\n" + rule + "\n";
   for (const CaseResult& c : cases) {
     out += fmt::format("| {} | {} | {} | {:.4f} / {} | {} | {:.4f} / {} | {:.2f} | {:.2f} | {:.1f} | {:.3f} | {:.3f} |", c.spec.name(),
-                       to_string(c.packed_with), c.initial.grains, c.packed.porosity, interior_text(c.packed),
+                       c.clump_template.empty() ? std::string(to_string(c.packed_with))
+                                                : fmt::format("{} (clumps of {})", to_string(c.packed_with), c.clump_template),
+                       c.initial.grains, c.packed.porosity, interior_text(c.packed),
                        packing_change_text(c.phases), c.initial.porosity, interior_text(c.initial), c.packed.coordination,
                        c.initial.coordination, c.test.peak_q / 1e3, 100 * c.test.peak_strain, 100 * c.test.peak_volumetric_strain);
     for (std::size_t k = 0; k < nl; ++k) {
@@ -786,6 +788,7 @@ StudyResult run_study(const StudySettings& settings, const std::vector<CaseSpec>
     r.grading = p.report;
     r.packed = p.state;
     r.packed_with = p.specimen.packed_with;
+    r.clump_template = p.specimen.clump_template;
     r.packing_file = p.file;
     Specimen s = p.specimen;  // a copy: every case starts from the same packed state
     Class5Material m = settings.material;
