@@ -15,6 +15,7 @@
 #include <omp.h>
 
 #include "commands.hpp"
+#include "hilldem/bodies/clump_shapes.hpp"
 #include "hilldem/core/error.hpp"
 #include "hilldem/io/output_folder.hpp"
 #include "hilldem/labtests/specimen_io.hpp"
@@ -55,6 +56,8 @@ struct Options {
   double d_mult = 1.0;
   double finalize_ratio = EquilibriumSettings{}.ratio;
   std::string specimen;
+  std::string clump_template;             // "" : balls
+  std::string clump_size = "equal-volume";
   bool no_plot = false;
   bool pack_only = false;
   bool grading_given = false;  // --grading on the command line
@@ -107,6 +110,12 @@ std::pair<StudySettings, std::vector<CaseSpec>> build(const Options& o) {
   s.suction = o.suction;
   s.moisture_gap = o.moisture_gap;
   s.specimen_file = o.specimen;
+  s.genesis.clump_template = o.clump_template;  // validated with the rest (the known names)
+  const std::string size = lower(o.clump_size);
+  if (size != "equal-volume" && size != "enclosing")
+    throw InputError("--clump-size must be equal-volume or enclosing, got '" + o.clump_size + "'");
+  if (o.clump_template.empty() && size != "equal-volume") throw InputError("--clump-size needs --clump-template");
+  s.genesis.clump_size = size == "enclosing" ? SizeMeasure::EnclosingDiameter : SizeMeasure::EqualVolumeDiameter;
   s.jobs = o.jobs;  // validated with the rest
   std::vector<CaseSpec> cases;
   if (o.study) {
@@ -161,6 +170,9 @@ int run_locked(const Options& o, const StudySettings& settings, const std::vecto
                             ? fmt::format(", each grading's scaled up to hold {} grains (--min-grains)", settings.min_grains)
                             : std::string(),
                         settings.output_dir);
+  if (log && !settings.genesis.clump_template.empty())
+    *log << fmt::format("grains: clumps of {} ({}), turned at random from the seed\n", settings.genesis.clump_template,
+                        to_string(settings.genesis.clump_size));
   if (o.pack_only) {
     const auto t0 = std::chrono::steady_clock::now();
     const std::clock_t c0 = std::clock();
@@ -230,6 +242,12 @@ Command add_triaxial_command(CLI::App& app) {
   cmd->add_option("--d-mult", o->d_mult, "diameter multiplier D_mult (default 1)")->check(finite_number());
   cmd->add_option("--finalize-ratio", o->finalize_ratio, "equilibrium ratio after finalization and wetting (default 8e-3)")->check(finite_number());
   cmd->add_option("--specimen", o->specimen, "start from a saved packed specimen (out/.../specimens/<grading>_packed.csv)");
+  cmd->add_option("--clump-template", o->clump_template,
+                  std::string("grains as clumps of this template (") + kNamedTemplates +
+                      "), each scaled to its drawn size and turned at random from the seed (docs/clumps.md); default: balls");
+  cmd->add_option("--clump-size", o->clump_size,
+                  "what a clump's drawn size is: equal-volume (the diameter of the sphere of equal volume, the default) or "
+                  "enclosing (the diameter of the smallest sphere about its centre of mass that holds it)");
   cmd->add_flag("--pack-only", o->pack_only,
                 "genesis only: pack the specimen(s) and save them to <output>/specimens/ for later --specimen runs");
   cmd->add_flag("--no-plot", o->no_plot, "do not run scripts/plot_triaxial.py");

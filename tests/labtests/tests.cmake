@@ -6,6 +6,7 @@ add_executable(hilldem_labtests_tests
   labtests/test_triaxial.cpp
   labtests/test_measure.cpp
   labtests/test_genesis.cpp
+  labtests/test_clump_specimens.cpp
 )
 target_link_libraries(hilldem_labtests_tests PRIVATE hilldem::core GTest::gtest_main)
 target_compile_definitions(hilldem_labtests_tests PRIVATE HILLDEM_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
@@ -166,3 +167,21 @@ foreach(mode t307 packing)
   set_tests_properties(cli.lab_test_stopped_by_signal_${mode} PROPERTIES TIMEOUT 300 LABELS "cli;labtests;reliability"
                        ENVIRONMENT OMP_NUM_THREADS=1)
 endforeach()
+
+# Clumped grains (docs/clumps.md, "Specimens of clumps"): what does not apply is refused before any work.
+add_test(NAME cli.triaxial_unknown_clump_template_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "unknown clump template 'cube'; known: sphere, elongated2, elongated3" --not-stdout "cloud"
+          2 $<TARGET_FILE:hilldem> triaxial --clump-template cube -o ${HILLDEM_TRIAXIAL_OUT}/clump1)
+add_test(NAME cli.triaxial_clump_density_scaling_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "density scaling does not apply to clumps" --not-stdout "cloud"
+          2 $<TARGET_FILE:hilldem> triaxial --clump-template elongated2 --density-scaling 2 -o ${HILLDEM_TRIAXIAL_OUT}/clump2)
+add_test(NAME cli.triaxial_clump_size_without_template_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "--clump-size needs --clump-template" --not-stdout "cloud"
+          2 $<TARGET_FILE:hilldem> triaxial --clump-size enclosing -o ${HILLDEM_TRIAXIAL_OUT}/clump3)
+add_test(NAME cli.triaxial_clumps_with_a_ball_specimen_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "the file's grains are balls"
+          2 $<TARGET_FILE:hilldem> triaxial --clump-template elongated2 --specimen ${HILLDEM_TEST_DATA}/labtests/mini_packed.csv
+            --grading ${HILLDEM_TEST_DATA}/labtests/fine.csv -o ${HILLDEM_TRIAXIAL_OUT}/clump4)
+set_tests_properties(cli.triaxial_unknown_clump_template_exits_2 cli.triaxial_clump_density_scaling_exits_2
+  cli.triaxial_clump_size_without_template_exits_2 cli.triaxial_clumps_with_a_ball_specimen_exits_2
+  PROPERTIES TIMEOUT 120 LABELS "cli;labtests;clumps")

@@ -13,6 +13,7 @@
 #include <ostream>
 #include <unordered_map>
 
+#include "hilldem/bodies/clump_shapes.hpp"
 #include "hilldem/control/controller_scope.hpp"
 #include "hilldem/core/error.hpp"
 #include "hilldem/labtests/measure_region.hpp"
@@ -96,11 +97,44 @@ void validate(const GenesisSpec& s) {
   check_range(e.wall_speed_limit > 0 && std::isfinite(e.wall_speed_limit), "wall speed limit [m/s]", e.wall_speed_limit, "> 0");
   check_range(e.porosity_change > 0 && e.porosity_change < 1, "porosity change per 1,000 steps", e.porosity_change, "in (0, 1)");
   check_range(e.porosity_window >= 1000, "porosity window [steps]", static_cast<double>(e.porosity_window), ">= 1000");
+  if (!s.clump_template.empty()) named_template(s.clump_template, s.grain.density);  // throws naming the known ones
   double d_max = 0.0;
   for (const GradingBin& b : s.grading.bins) d_max = std::max(d_max, b.d_upper * s.d_mult);
   if (d_max >= std::min(2 * s.vessel_radius, s.vessel_height))
     throw InputError(fmt::format("the largest grain ({:g} mm) does not fit in the vessel ({:g} mm x {:g} mm)",
                                  d_max * 1e3, 2e3 * s.vessel_radius, 1e3 * s.vessel_height));
+}
+
+const char* to_string(SizeMeasure m) {
+  return m == SizeMeasure::EnclosingDiameter ? "sizes = enclosing diameter" : "sizes = equal-volume diameter";
+}
+
+namespace {
+// Each clump's union volume [m³]: its mass over its pebbles' density (ρV / ρ).
+std::vector<double> clump_volumes(const Simulation& sim) {
+  const ClumpBodies& c = sim.clumps;
+  std::vector<double> v(c.size(), 0.0);
+  for (std::size_t k = 0; k < c.pebbles.size(); ++k) {
+    const std::uint32_t i = c.pebbles.clump[k];
+    if (v[i] == 0.0) v[i] = c.state.mass[i] / sim.balls.density[c.ball[k]];
+  }
+  return v;
+}
+}  // namespace
+
+std::size_t grain_count(const Simulation& sim) { return sim.balls.size() - sim.clumps.pebbles.size() + sim.clumps.size(); }
+
+double solid_volume(const Simulation& sim) {
+  double solid = 0.0;
+  if (sim.clumps.empty()) {
+    for (double r : sim.balls.radius) solid += 4.0 / 3.0 * std::numbers::pi * r * r * r;
+    return solid;
+  }
+  const std::vector<std::uint32_t> of = sim.clumps.clump_of_balls(sim.balls.size());
+  for (double v : clump_volumes(sim)) solid += v;
+  for (std::size_t i = 0; i < sim.balls.size(); ++i)
+    if (of[i] == kNoClump) solid += 4.0 / 3.0 * std::numbers::pi * sim.balls.radius[i] * sim.balls.radius[i] * sim.balls.radius[i];
+  return solid;
 }
 
 std::string criterion_text(const EquilibriumSettings& e) {
@@ -163,23 +197,64 @@ std::string PhaseReport::line() const {
 }
 
 std::vector<double> Specimen::diameters() const {
-  std::vector<double> d(sim.balls.size());
-  for (std::size_t i = 0; i < d.size(); ++i) d[i] = 2.0 * sim.balls.radius[i];
+  if (sim.clumps.empty()) {
+    std::vector<double> d(sim.balls.size());
+    for (std::size_t i = 0; i < d.size(); ++i) d[i] = 2.0 * sim.balls.radius[i];
+    return d;
+  }
+  const ClumpBodies& c = sim.clumps;
+  std::vector<double> d;
+  if (clump_size == SizeMeasure::EnclosingDiameter) {
+    d.assign(c.size(), 0.0);
+    for (std::size_t k = 0; k < c.pebbles.size(); ++k) {
+      double& x = d[c.pebbles.clump[k]];
+      x = std::max(x, 2.0 * (norm(c.pebbles.body_position[k]) + c.pebbles.radius[k]));
+    }
+  } else {
+    for (double v : clump_volumes(sim)) d.push_back(std::cbrt(6.0 * v / std::numbers::pi));
+  }
+  const std::vector<std::uint32_t> of = c.clump_of_balls(sim.balls.size());
+  for (std::size_t i = 0; i < sim.balls.size(); ++i)
+    if (of[i] == kNoClump) d.push_back(2.0 * sim.balls.radius[i]);
   return d;
+}
+
+double interior_porosity(const MeasurementCylinder& m, const Simulation& sim) {
+  if (sim.clumps.empty()) return region_porosity(m, sim.balls.position, sim.balls.radius);
+  const ClumpBodies& c = sim.clumps;
+  const std::vector<double> volume = clump_volumes(sim);
+  double solid = 0.0;
+  std::vector<Vec3> centres;
+  std::vector<double> radii;
+  for (std::size_t k = 0; k < c.pebbles.size();) {  // the pebbles of a clump are consecutive (ClumpBodies::add)
+    const std::uint32_t i = c.pebbles.clump[k];
+    centres.clear();
+    radii.clear();
+    for (; k < c.pebbles.size() && c.pebbles.clump[k] == i; ++k) {
+      centres.push_back(sim.balls.position[c.ball[k]]);
+      radii.push_back(sim.balls.radius[c.ball[k]]);
+    }
+    solid += clump_volume_inside(m, centres, radii, volume[i]);
+  }
+  const std::vector<std::uint32_t> of = c.clump_of_balls(sim.balls.size());
+  for (std::size_t b = 0; b < sim.balls.size(); ++b)
+    if (of[b] == kNoClump) solid += sphere_volume_inside(m, sim.balls.position[b], sim.balls.radius[b]);
+  const double v = m.volume();
+  return v > 0.0 ? 1.0 - solid / v : 0.0;
 }
 
 SpecimenState measure(const Specimen& s, bool interior) {
   const Simulation& sim = s.sim;
   SpecimenState st;
-  st.grains = sim.balls.size();
-  double solid = 0.0;
-  for (double r : sim.balls.radius) solid += 4.0 / 3.0 * std::numbers::pi * r * r * r;
+  st.grains = grain_count(sim);
+  const double solid = solid_volume(sim);
+  const std::vector<double> sizes = s.diameters();
   st.radius = s.vessel.radius(sim);
   st.height = s.vessel.height(sim);
   st.porosity = 1.0 - solid / s.vessel.volume(sim);
   if (interior) {
     double d_max = 0.0;
-    for (double r : sim.balls.radius) d_max = std::max(d_max, 2.0 * r);
+    for (double d : sizes) d_max = std::max(d_max, d);
     // The region must hold at least one D_max in radius and two in height. Margin D_max from every
     // wall; failing that (a small vessel) D50; failing that there is no interior to measure.
     auto region = [&](double margin) {
@@ -191,14 +266,21 @@ SpecimenState measure(const Specimen& s, bool interior) {
     if (d_max > 0.0 && fits(region(d_max))) {
       st.interior_margin = SpecimenState::Margin::DMax;
       st.interior_margin_length = d_max;
-    } else if (const double d50 = volume_median_diameter(s.diameters()); d50 > 0.0 && fits(region(d50))) {
+    } else if (const double d50 = volume_median_diameter(sizes); d50 > 0.0 && fits(region(d50))) {
       st.interior_margin = SpecimenState::Margin::D50;
       st.interior_margin_length = d50;
     }
     if (st.interior_margin != SpecimenState::Margin::None)
-      st.interior_porosity = region_porosity(region(st.interior_margin_length), sim.balls.position, sim.balls.radius);
+      st.interior_porosity = interior_porosity(region(st.interior_margin_length), sim);
   } else {
     st.interior_porosity = st.porosity;  // not measured: the vessel's
+  }
+  // Contacts per grain: a pebble's count as its clump's (grains: clumps first, then the other balls).
+  const std::vector<std::uint32_t> of = sim.clumps.clump_of_balls(sim.balls.size());
+  std::vector<std::uint32_t> grain_of(sim.balls.size());
+  {
+    std::uint32_t next = static_cast<std::uint32_t>(sim.clumps.size());
+    for (std::size_t i = 0; i < grain_of.size(); ++i) grain_of[i] = of.empty() ? static_cast<std::uint32_t>(i) : of[i] != kNoClump ? of[i] : next++;
   }
   std::vector<std::uint32_t> per_ball(st.grains, 0);
   std::size_t touching = 0;
@@ -210,8 +292,8 @@ SpecimenState measure(const Specimen& s, bool interior) {
       ++st.wet_contacts;
     if (k.kind != ContactKind::BallBall || !sim.contacts.active[c] || sim.contacts.gap[c] >= 0.0) continue;
     ++touching;
-    ++per_ball[k.a];
-    ++per_ball[k.b];
+    ++per_ball[grain_of[k.a]];
+    ++per_ball[grain_of[k.b]];
   }
   if (st.grains > 0) st.coordination = 2.0 * static_cast<double>(touching) / static_cast<double>(st.grains);
   std::size_t n0 = 0, n1 = 0;
@@ -247,20 +329,38 @@ Specimen make_cloud(const GenesisSpec& spec) {
 
   Rng rng(p.seed);
   const double volume = std::numbers::pi * R * R * H;
-  const GrainSample sample = sample_grains(spec.grading, spec.d_mult, (1.0 - p.cloud_porosity) * volume, rng);
+  const Class5Material& grain_defaults = spec.grain;  // density, E, ν until finalization sets the material
+  const bool clumps = !spec.clump_template.empty();
+  s.clump_template = spec.clump_template;
+  s.clump_size = spec.clump_size;
+  ClumpTemplate unit;
+  // A clump of size d by the chosen measure has volume f π d³/6: f = 1 for the equal-volume diameter,
+  // below 1 for the enclosing one. The grading is sampled for the solid volume (1 − n_c) V_vessel / f
+  // in spheres of the drawn sizes, so that the clumps' union volumes fill (1 − n_c) V_vessel.
+  double volume_factor = 1.0;
+  if (clumps) {
+    unit = named_template(spec.clump_template, grain_defaults.density);
+    const double d = unit.size(spec.clump_size);
+    volume_factor = unit.volume / (std::numbers::pi * d * d * d / 6.0);
+  }
+  const GrainSample sample =
+      sample_grains(spec.grading, spec.d_mult, (1.0 - p.cloud_porosity) * volume / volume_factor, rng);
   std::vector<std::size_t> order(sample.diameters.size());
   std::iota(order.begin(), order.end(), std::size_t{0});
   std::stable_sort(order.begin(), order.end(),
                    [&](std::size_t a, std::size_t b) { return sample.diameters[a] > sample.diameters[b]; });
-  const double d_max = order.empty() ? 0.0 : sample.diameters[order.front()];
+  // A clump is placed as the sphere that encloses it (about its centre of mass): its enclosing radius
+  // is d/2 × (enclosing diameter / size) of the unit template.
+  const double enclosing = clumps ? unit.size(SizeMeasure::EnclosingDiameter) / unit.size(spec.clump_size) : 1.0;
+  const double d_max = order.empty() ? 0.0 : sample.diameters[order.front()] * enclosing;
   PlacementGrid grid(R, H, std::max(d_max, 1e-9));
   std::vector<Vec3> pos;
   std::vector<double> rad;
   pos.reserve(order.size());
   rad.reserve(order.size());
-  const Class5Material& grain_defaults = spec.grain;  // density, E, ν until finalization sets the material
+  std::int64_t next_id = 1;
   for (std::size_t i : order) {
-    const double r = 0.5 * sample.diameters[i];
+    const double r = 0.5 * sample.diameters[i] * enclosing;
     Vec3 best;
     double best_overlap = std::numeric_limits<double>::infinity();
     for (int t = 0; t < std::max(1, p.placement_tries); ++t) {
@@ -274,8 +374,25 @@ Specimen make_cloud(const GenesisSpec& spec) {
     grid.insert(pos.size(), best);
     pos.push_back(best);
     rad.push_back(r);
+    if (clumps) {
+      // A uniformly random rotation (Shoemake, Graphics Gems III, 1992), drawn after the position.
+      const double u1 = rng.uniform(), u2 = 2.0 * std::numbers::pi * rng.uniform(), u3 = 2.0 * std::numbers::pi * rng.uniform();
+      const Quat q{std::sqrt(1.0 - u1) * std::sin(u2), std::sqrt(1.0 - u1) * std::cos(u2), std::sqrt(u1) * std::sin(u3),
+                   std::sqrt(u1) * std::cos(u3)};
+      const ClumpTemplate t = unit.scaled(sample.diameters[i], spec.clump_size);
+      ClumpInit c;
+      c.first_ball_id = next_id;
+      c.position = best;
+      c.orientation = normalized(q);
+      c.young_mod = grain_defaults.young_mod;
+      c.pois_ratio = grain_defaults.pois_ratio;
+      c.groups = grain_bit;
+      sim.clumps.add(sim.balls, t, c);
+      next_id += static_cast<std::int64_t>(t.pebbles.size());
+      continue;
+    }
     BallInit b;
-    b.id = static_cast<std::int64_t>(pos.size());
+    b.id = next_id++;
     b.position = best;
     b.radius = r;
     b.density = grain_defaults.density;
@@ -296,11 +413,28 @@ PhaseReport relax_cloud(Specimen& s, const PackingSettings& p, std::ostream* log
   double d_min = std::numeric_limits<double>::infinity();
   for (double r : sim.balls.radius) d_min = std::min(d_min, 2.0 * r);
   const double cap = p.cloud_speed_limit;
+  // A clump's speed is capped at its centre of mass, and its spin so that no point of it within its
+  // enclosing radius moves faster than the cap from the turn (ω and L_b scaled together: ω = R I⁻¹ L_b).
+  std::vector<double> reach(sim.clumps.size(), 0.0);
+  for (std::size_t k = 0; k < sim.clumps.pebbles.size(); ++k) {
+    double& x = reach[sim.clumps.pebbles.clump[k]];
+    x = std::max(x, norm(sim.clumps.pebbles.body_position[k]) + sim.clumps.pebbles.radius[k]);
+  }
   ControllerScope scope(sim);
-  sim.controllers.push_back([cap](Simulation& m, double) {
+  sim.controllers.push_back([cap, reach](Simulation& m, double) {
     for (Vec3& v : m.balls.velocity) {
       const double speed = norm(v);
       if (speed > cap) v *= cap / speed;
+    }
+    ClumpState& c = m.clumps.state;
+    for (std::size_t i = 0; i < c.size(); ++i) {
+      const double speed = norm(c.velocity[i]);
+      if (speed > cap) c.velocity[i] *= cap / speed;
+      const double turn = norm(c.spin[i]) * reach[i];
+      if (turn > cap) {
+        c.spin[i] *= cap / turn;
+        c.body_momentum[i] *= cap / turn;
+      }
     }
   });
   const std::int64_t start = sim.steps;
@@ -322,6 +456,12 @@ PhaseReport relax_cloud(Specimen& s, const PackingSettings& p, std::ostream* log
   }
   for (Vec3& v : sim.balls.velocity) v = Vec3{};
   for (Vec3& w : sim.balls.spin) w = Vec3{};
+  if (!sim.clumps.empty()) {
+    for (Vec3& v : sim.clumps.state.velocity) v = Vec3{};
+    for (Vec3& w : sim.clumps.state.spin) w = Vec3{};
+    for (Vec3& l : sim.clumps.state.body_momentum) l = Vec3{};
+    sim.clumps.place_pebbles(sim.balls);
+  }
   PhaseReport r{"cloud", sim.steps - start, seconds_since(t0), measure(s)};
   if (log) *log << r.line() << std::endl;
   s.phases.push_back(r);
@@ -344,8 +484,7 @@ PhaseReport servo_equilibrium(Specimen& s, const EquilibriumSettings& e, const s
   const std::int64_t progress_every = 20000;
   std::int64_t next_progress = start + progress_every;
   auto within = [&](double stress) { return std::abs(stress - e.pressure) <= e.pressure_tolerance * e.pressure; };
-  double solid = 0.0;
-  for (double r : sim.balls.radius) solid += 4.0 / 3.0 * std::numbers::pi * r * r * r;
+  const double solid = solid_volume(sim);
   auto porosity = [&] { return 1.0 - solid / s.vessel.volume(sim); };
   PorosityHistory history(e.porosity_window);
   history.add(sim.steps, porosity());
@@ -387,9 +526,14 @@ Specimen pack_specimen(const GenesisSpec& spec, std::ostream* log) {
   const auto t0 = std::chrono::steady_clock::now();
   Specimen s = make_cloud(spec);
   if (log)
-    *log << fmt::format("cloud: {} grains of {} at porosity {:.3f} in a {:.0f} mm x {:.0f} mm vessel (seed {}, {:.1f} s); "
+    *log << fmt::format("cloud: {} grains{} of {} at porosity {:.3f} in a {:.0f} mm x {:.0f} mm vessel (seed {}, {:.1f} s); "
                         "packing contacts {} with friction {:g}; converged when {}\n",
-                        s.sim.balls.size(), spec.grading.name, measure(s).porosity, 2e3 * spec.vessel_radius,
+                        grain_count(s.sim),
+                        s.clump_template.empty()
+                            ? std::string()
+                            : fmt::format(" (clumps of {}, {} pebbles, {})", s.clump_template, s.sim.clumps.pebbles.size(),
+                                          to_string(s.clump_size)),
+                        spec.grading.name, measure(s).porosity, 2e3 * spec.vessel_radius,
                         1e3 * spec.vessel_height, spec.packing.seed, seconds_since(t0), to_string(spec.packing.contact.model),
                         spec.packing.contact.fric, criterion_text(spec.packing.equilibrium));
   relax_cloud(s, spec.packing, log);

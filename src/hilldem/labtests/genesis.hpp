@@ -10,9 +10,11 @@
 #include <string>
 #include <vector>
 
+#include "hilldem/bodies/clump_template.hpp"
 #include "hilldem/engine/simulation.hpp"
 #include "hilldem/labtests/gsd.hpp"
 #include "hilldem/labtests/material.hpp"
+#include "hilldem/labtests/measure_region.hpp"
 #include "hilldem/labtests/vessel.hpp"
 
 namespace hilldem {
@@ -74,6 +76,12 @@ struct GenesisSpec {
   // material's model and friction are not used here (packing.contact says how grains are packed).
   Class5Material grain;
   PackingSettings packing;
+  // Grains as clumps (docs/clumps.md, "Specimens of clumps"): empty for balls, else a named template
+  // (bodies/clump_shapes.hpp: sphere, elongated2, elongated3). Each grain is the template scaled so
+  // that its size by clump_size is the size drawn from the grading, turned to a uniformly random
+  // orientation drawn from the seed after its position.
+  std::string clump_template;
+  SizeMeasure clump_size = SizeMeasure::EqualVolumeDiameter;
   // Not physics: given to every Simulation made from this spec (Simulation::interrupt), and by
   // make_packed to a specimen it loads, so that a lab test stops between two cycles when it
   // answers true (the CLI: on SIGINT, SIGTERM, SIGHUP), throwing Interrupted.
@@ -94,7 +102,10 @@ struct SpecimenState {
   double interior_porosity = 0.0;
   enum class Margin : std::uint8_t { DMax, D50, None } interior_margin = Margin::DMax;
   double interior_margin_length = 0.0;  // the margin [m] (0 when None)
-  double coordination = 0.0;        // 2 N_c / N_grains, touching grain-grain contacts [-]
+  // 2 N_c / N_grains, N_c the touching contacts between two grains [-]. With clumps each touching
+  // pebble-pebble (or pebble-ball) contact counts once, as PFC counts the contacts of a clump; two
+  // clumps may touch at more than one.
+  double coordination = 0.0;
   double mech_coordination = 0.0;   // Thornton's: grains with < 2 contacts left out [-]
   double radial_stress = 0.0;       // lateral wall [Pa]
   double bottom_stress = 0.0, top_stress = 0.0;  // platens [Pa]
@@ -126,12 +137,28 @@ struct Specimen {
   GrainModel packed_with = GrainModel::Linear;  // the grain-grain model of the packing contacts
   bool wet = false;
   std::vector<PhaseReport> phases;     // genesis history
+  // Grains as clumps of this named template ("" for balls), sized by clump_size.
+  std::string clump_template;
+  SizeMeasure clump_size = SizeMeasure::EqualVolumeDiameter;
+  // The grains' sizes [m]: a ball's diameter; a clump's size by clump_size (the equal-volume
+  // diameter (6V/π)^(1/3), or the enclosing diameter 2 max_k(|p_k| + r_k)), clumps first in clump order.
   std::vector<double> diameters() const;
 };
+
+// The grains: the clumps and the balls that are not pebbles.
+std::size_t grain_count(const Simulation& sim);
+// The grains' solid volume [m³]: 4/3 π r³ per ball that is not a pebble, the union volume m/ρ per
+// clump (its pebbles' overlaps counted once: the template's, docs/clumps.md).
+double solid_volume(const Simulation& sim);
+// "sizes = equal-volume diameter" or "sizes = enclosing diameter", for logs.
+const char* to_string(SizeMeasure m);
 
 // The specimen's state; `interior` false skips the measurement-cylinder porosity (set to the vessel's),
 // for frequent records.
 SpecimenState measure(const Specimen& s, bool interior = true);
+// The porosity in region m [-]: 1 − Σ (each grain's volume inside m) / m's volume, a ball's by
+// sphere_volume_inside, a clump's by clump_volume_inside (its pebbles' overlaps counted once).
+double interior_porosity(const MeasurementCylinder& m, const Simulation& sim);
 // The interior porosity as printed: "0.3072" with the D_max margin, "0.3301 (D50 margin)" with the
 // smaller one, "n/a (vessel radius under D_max + D50 or height under 2 (D_max + D50))" when it cannot
 // be measured. Never "nan".

@@ -1,5 +1,7 @@
 #include "hilldem/labtests/material.hpp"
 
+#include <algorithm>
+
 namespace hilldem {
 
 const char* to_string(GrainModel m) { return m == GrainModel::Hill ? "hill" : "linear"; }
@@ -70,7 +72,33 @@ void install_table(Simulation& sim, ModelTable table) {
 }
 
 void apply_grain_properties(Simulation& sim, const Class5Material& m) {
+  ClumpBodies& c = sim.clumps;
+  if (!c.empty()) {
+    // A clump's mass and inertia scale with its density (same union volume); L_b with them, so that
+    // its spin is kept. Its pebbles' mass and inertia columns are the clump's (clump_bodies.hpp).
+    std::vector<double> factor(c.size(), 0.0);
+    for (std::size_t k = 0; k < c.pebbles.size(); ++k) {
+      const std::uint32_t i = c.pebbles.clump[k];
+      if (factor[i] == 0.0) factor[i] = m.density / sim.balls.density[c.ball[k]];
+    }
+    for (std::size_t i = 0; i < c.size(); ++i) {
+      c.state.mass[i] *= factor[i];
+      c.state.principal_inertia[i] *= factor[i];
+      c.state.body_momentum[i] *= factor[i];
+    }
+    for (std::size_t k = 0; k < c.pebbles.size(); ++k) {
+      const std::uint32_t b = c.ball[k], i = c.pebbles.clump[k];
+      sim.balls.density[b] = m.density;
+      sim.balls.young_mod[b] = m.young_mod;
+      sim.balls.pois_ratio[b] = m.pois_ratio;
+      const Vec3& in = c.state.principal_inertia[i];
+      sim.balls.mass[b] = c.state.mass[i];
+      sim.balls.inertia[b] = std::min(in.x, std::min(in.y, in.z));
+    }
+  }
+  const std::vector<std::uint32_t> of = c.clump_of_balls(sim.balls.size());
   for (std::size_t i = 0; i < sim.balls.size(); ++i) {
+    if (!of.empty() && of[i] != kNoClump) continue;
     sim.balls.density[i] = m.density;
     sim.balls.young_mod[i] = m.young_mod;
     sim.balls.pois_ratio[i] = m.pois_ratio;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <utility>
 
 namespace hilldem {
 
@@ -43,6 +44,53 @@ double sphere_volume_inside(const MeasurementCylinder& m, const Vec3& c, double 
     sum += area * (k == 0 || k == n ? 1.0 : (k % 2 ? 4.0 : 2.0));
   }
   return sum * h / 3.0;
+}
+
+double clump_volume_inside(const MeasurementCylinder& m, const std::vector<Vec3>& c, const std::vector<double>& r, double volume,
+                           int n) {
+  if (c.size() == 1) return sphere_volume_inside(m, c[0], r[0]);
+  bool all_in = true, all_out = true;
+  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  for (std::size_t k = 0; k < c.size(); ++k) {
+    const double rho = std::hypot(c[k].x, c[k].y);
+    all_in = all_in && rho + r[k] <= m.radius && c[k].z - r[k] >= m.z_lo && c[k].z + r[k] <= m.z_hi;
+    all_out = all_out && (rho - r[k] >= m.radius || c[k].z - r[k] >= m.z_hi || c[k].z + r[k] <= m.z_lo);
+    lo = Vec3{std::min(lo.x, c[k].x - r[k]), std::min(lo.y, c[k].y - r[k]), 0.0};
+    hi = Vec3{std::max(hi.x, c[k].x + r[k]), std::max(hi.y, c[k].y + r[k]), 0.0};
+  }
+  if (all_in) return volume;
+  if (all_out) return 0.0;
+  const double hx = (hi.x - lo.x) / n, hy = (hi.y - lo.y) / n;
+  std::vector<std::pair<double, double>> chords;
+  double total = 0.0, inside = 0.0;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const double x = lo.x + (i + 0.5) * hx, y = lo.y + (j + 0.5) * hy;
+      chords.clear();
+      for (std::size_t k = 0; k < c.size(); ++k) {
+        const double h2 = r[k] * r[k] - (x - c[k].x) * (x - c[k].x) - (y - c[k].y) * (y - c[k].y);
+        if (h2 > 0.0) chords.emplace_back(c[k].z - std::sqrt(h2), c[k].z + std::sqrt(h2));
+      }
+      if (chords.empty()) continue;
+      std::sort(chords.begin(), chords.end());
+      const bool in_radius = x * x + y * y <= m.radius * m.radius;
+      // The union of the chords: merge overlapping intervals in order of their lower ends.
+      double a = chords[0].first, b = chords[0].second;
+      auto close = [&] {
+        total += b - a;
+        if (in_radius) inside += std::max(0.0, std::min(b, m.z_hi) - std::max(a, m.z_lo));
+      };
+      for (std::size_t k = 1; k < chords.size(); ++k) {
+        if (chords[k].first > b) {
+          close();
+          a = chords[k].first, b = chords[k].second;
+        } else {
+          b = std::max(b, chords[k].second);
+        }
+      }
+      close();
+    }
+  return total > 0.0 ? volume * inside / total : 0.0;
 }
 
 double region_porosity(const MeasurementCylinder& m, const std::vector<Vec3>& centres, const std::vector<double>& radii) {

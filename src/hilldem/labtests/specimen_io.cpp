@@ -10,6 +10,7 @@
 #include <map>
 #include <sstream>
 
+#include "hilldem/bodies/clump_shapes.hpp"
 #include "hilldem/core/error.hpp"
 
 namespace hilldem {
@@ -27,8 +28,8 @@ std::string trim(const std::string& s) {
 }  // namespace
 
 namespace {
-// Every pair of grains on a grid of cells one largest diameter wide: overlaps beyond kMaxOverlap of
-// the smaller diameter, or two grains at one centre, refuse the file.
+// Every pair of grains (or pebbles of different clumps) on a grid of cells one largest diameter wide:
+// overlaps beyond kMaxOverlap of the smaller diameter, or two at one centre, refuse the file.
 template <class Row>
 void check_overlaps(const std::vector<Row>& rows, const std::string& source) {
   if (rows.empty()) return;
@@ -49,6 +50,7 @@ void check_overlaps(const std::vector<Row>& rows, const std::string& source) {
           for (std::size_t j : it->second) {
             if (j <= i) continue;
             const Row& b = rows[j];
+            if (a.body == b.body) continue;  // pebbles of one clump overlap by design
             const double d = std::sqrt((a.v[0] - b.v[0]) * (a.v[0] - b.v[0]) + (a.v[1] - b.v[1]) * (a.v[1] - b.v[1]) +
                                        (a.v[2] - b.v[2]) * (a.v[2] - b.v[2]));
             const double d_small = 2.0 * std::min(a.v[3], b.v[3]);
@@ -91,6 +93,27 @@ std::string packed_specimen_text(const Specimen& s, const PackingSettings& p) {
   out += fmt::format("packing_fric,{}\n", p.contact.fric);
   out += fmt::format("wall_emod[Pa],{}\n", p.walls.emod);
   out += fmt::format("wall_kratio,{}\n", p.walls.kratio);
+  if (!s.clump_template.empty()) {
+    // A clump row: its first pebble's ball id (the others follow), centre of mass, orientation (the
+    // principal frame's, a unit quaternion), the factor its unit template (pebbles of radius 1) is
+    // scaled by, and its pebbles' properties. Every number is written to round trip exactly.
+    const ClumpBodies& c = sim.clumps;
+    if (grain_count(sim) != c.size()) throw InputError("a specimen of clumps and balls together cannot be saved");
+    out += fmt::format("clump_template,{}\n", s.clump_template);
+    out += fmt::format("clump_size,{}\n", s.clump_size == SizeMeasure::EnclosingDiameter ? "enclosing" : "equal-volume");
+    out += fmt::format("grains,{}\n", c.size());
+    out += "id,x[m],y[m],z[m],qw,qx,qy,qz,scale[m],density[kg/m3],young_mod[Pa],pois_ratio[-]\n";
+    std::vector<std::size_t> first(c.size(), c.pebbles.size());
+    for (std::size_t k = c.pebbles.size(); k-- > 0;) first[c.pebbles.clump[k]] = k;
+    for (std::size_t i = 0; i < c.size(); ++i) {
+      const std::uint32_t b = c.ball[first[i]];
+      const Vec3& x = c.state.position[i];
+      const Quat& q = c.state.orientation[i];
+      out += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{}\n", sim.balls.id[b], x.x, x.y, x.z, q.w, q.x, q.y, q.z,
+                         c.pebbles.radius[first[i]], sim.balls.density[b], sim.balls.young_mod[b], sim.balls.pois_ratio[b]);
+    }
+    return out;
+  }
   out += fmt::format("grains,{}\n", sim.balls.size());
   out += "id,x[m],y[m],z[m],radius[m],density[kg/m3],young_mod[Pa],pois_ratio[-]\n";
   for (std::size_t i = 0; i < sim.balls.size(); ++i) {
@@ -119,9 +142,12 @@ Specimen parse_packed_specimen(const std::string& text, const std::string& sourc
   bool header = false;
   struct Row {
     std::int64_t id;
-    double v[7];
+    double v[11];
     int line;
+    std::size_t body;
   };
+  // A clump file has its template's name before the table (clump_template) and clump rows.
+  bool clump_file = false;
   std::vector<Row> rows;
   while (std::getline(in, line)) {
     ++lineno;
@@ -136,7 +162,11 @@ Specimen parse_packed_specimen(const std::string& text, const std::string& sourc
         throw fail(lineno, fmt::format("not a hilldem specimen file: the first line must be `format,{},{}`", kMagic, kVersion));
       if (cells.size() >= 1 && cells[0] == "id") {
         header = true;
-        if (cells.size() != 8) throw fail(lineno, "expected the header id,x[m],y[m],z[m],radius[m],density[kg/m3],young_mod[Pa],pois_ratio[-]");
+        clump_file = keys.count("clump_template") > 0;
+        if (clump_file && cells.size() != 12)
+          throw fail(lineno, "expected the header id,x[m],y[m],z[m],qw,qx,qy,qz,scale[m],density[kg/m3],young_mod[Pa],pois_ratio[-]");
+        if (!clump_file && cells.size() != 8)
+          throw fail(lineno, "expected the header id,x[m],y[m],z[m],radius[m],density[kg/m3],young_mod[Pa],pois_ratio[-]");
         continue;
       }
       if (cells.size() < 2) throw fail(lineno, "expected `key,value`, got '" + line + "'");
@@ -144,13 +174,15 @@ Specimen parse_packed_specimen(const std::string& text, const std::string& sourc
       keys[cells[0]] = {cells.size() == 3 && cells[0] == "format" ? cells[1] + "," + cells[2] : cells[1], lineno};
       continue;
     }
-    if (cells.size() != 8) throw fail(lineno, fmt::format("expected 8 values, got {}", cells.size()));
+    const std::size_t columns = clump_file ? 12 : 8;
+    if (cells.size() != columns) throw fail(lineno, fmt::format("expected {} values, got {}", columns, cells.size()));
     Row r{};
     r.line = lineno;
+    r.body = rows.size();
     char* end = nullptr;
     r.id = std::strtoll(cells[0].c_str(), &end, 10);
     if (cells[0].empty() || *end != '\0' || r.id < 0) throw fail(lineno, "bad ball id '" + cells[0] + "'");
-    for (int k = 0; k < 7; ++k) {
+    for (std::size_t k = 0; k + 1 < columns; ++k) {
       r.v[k] = std::strtod(cells[k + 1].c_str(), &end);
       if (cells[k + 1].empty() || *end != '\0' || !std::isfinite(r.v[k])) throw fail(lineno, "bad number '" + cells[k + 1] + "'");
     }
@@ -159,16 +191,22 @@ Specimen parse_packed_specimen(const std::string& text, const std::string& sourc
       double lo, hi;
       bool lo_open;
     };
-    static constexpr Range ranges[] = {{"radius[m]", kMinGrainRadius, kMaxGrainRadius, false},
+    const Range ranges[] = {{clump_file ? "scale[m]" : "radius[m]", kMinGrainRadius, kMaxGrainRadius, false},
                                        {"density[kg/m3]", kMinGrainDensity, kMaxGrainDensity, false},
                                        {"young_mod[Pa]", kMinGrainModulus, kMaxGrainModulus, false},
                                        {"pois_ratio[-]", kMinPoisson, kMaxPoisson, true}};
+    const int first_property = clump_file ? 7 : 3;  // scale (or radius), density, E, ν
     for (int k = 0; k < 4; ++k) {
       const Range& g = ranges[k];
-      const double x = r.v[k + 3];
+      const double x = r.v[k + first_property];
       if ((g.lo_open ? x <= g.lo : x < g.lo) || x > g.hi)
         throw fail(lineno, fmt::format("grain {}: {} must be in {}{:g}, {:g}], got {:g}", r.id, g.column, g.lo_open ? "(" : "[", g.lo,
                                        g.hi, x));
+    }
+    if (clump_file) {
+      const double q2 = r.v[3] * r.v[3] + r.v[4] * r.v[4] + r.v[5] * r.v[5] + r.v[6] * r.v[6];
+      if (std::abs(q2 - 1.0) > 1e-9)
+        throw fail(lineno, fmt::format("clump {}: the orientation (qw, qx, qy, qz) must be a unit quaternion, got |q|^2 = {:.12g}", r.id, q2));
     }
     rows.push_back(r);
   }
@@ -227,17 +265,62 @@ Specimen parse_packed_specimen(const std::string& text, const std::string& sourc
   s.vessel = add_vessel(sim, radius, top - bottom, sim.groups.bit(kVesselGroup));
   sim.walls.walls[s.vessel.bottom].point.z = sim.walls.walls[s.vessel.bottom].rotation_center.z = bottom;
   sim.walls.walls[s.vessel.top].point.z = sim.walls.walls[s.vessel.top].rotation_center.z = top;
+  // Each grain's pebbles or ball as (centre, radius) rows, checked against the vessel and each other.
+  std::vector<Row> spheres;
+  if (clump_file) {
+    const auto [name, at] = get("clump_template");
+    const auto [size, size_at] = get("clump_size");
+    if (size == "enclosing") s.clump_size = SizeMeasure::EnclosingDiameter;
+    else if (size != "equal-volume") throw fail(size_at, "clump_size must be equal-volume or enclosing, got '" + size + "'");
+    try {
+      named_template(name, 1000.0);
+    } catch (const InputError& e) {
+      throw fail(at, e.what());
+    }
+    s.clump_template = name;
+  }
   for (const Row& r : rows) {
-    if (sim.balls.find(r.id) >= 0) throw fail(r.line, fmt::format("duplicate ball id {}", r.id));
+    if (!clump_file) {
+      spheres.push_back(r);
+      continue;
+    }
+    // The clump as saved: its unit template scaled by `scale` (bitwise the genesis's: the unit's
+    // pebble radius is 1), its orientation and centre written over those add() computes.
+    const ClumpTemplate t = named_template(s.clump_template, r.v[8]).scaled_by(r.v[7]);
+    for (std::size_t k = 0; k < t.pebbles.size(); ++k)
+      if (sim.balls.find(r.id + static_cast<std::int64_t>(k)) >= 0) throw fail(r.line, fmt::format("duplicate ball id {}", r.id + k));
+    ClumpInit c;
+    c.first_ball_id = r.id;
+    c.position = Vec3{r.v[0], r.v[1], r.v[2]};
+    c.young_mod = r.v[9];
+    c.pois_ratio = r.v[10];
+    c.groups = grain_bit;
+    const std::size_t i = sim.clumps.add(sim.balls, t, c);
+    sim.clumps.state.orientation[i] = Quat{r.v[3], r.v[4], r.v[5], r.v[6]};
+    for (std::size_t k = 0; k < sim.clumps.pebbles.size(); ++k) {
+      if (sim.clumps.pebbles.clump[k] != i) continue;
+      const Vec3 x = pebble_position(sim.clumps.state, sim.clumps.pebbles, k);
+      Row p{};
+      p.id = r.id;
+      p.v[0] = x.x, p.v[1] = x.y, p.v[2] = x.z, p.v[3] = sim.clumps.pebbles.radius[k];
+      p.line = r.line;
+      p.body = r.body;
+      spheres.push_back(p);
+    }
+  }
+  for (const Row& r : spheres) {
     const Vec3 x{r.v[0], r.v[1], r.v[2]};
-    if (std::hypot(x.x, x.y) > radius || x.z < bottom || x.z > top)
-      throw fail(r.line, fmt::format("ball {} lies outside the vessel", r.id));
     const double rad = r.v[3];
+    const char* what = clump_file ? "a pebble of clump" : "ball";
+    if (!clump_file && sim.balls.find(r.id) >= 0) throw fail(r.line, fmt::format("duplicate ball id {}", r.id));
+    if (std::hypot(x.x, x.y) > radius || x.z < bottom || x.z > top)
+      throw fail(r.line, fmt::format("{} {} lies outside the vessel", what, r.id));
     const double beyond = std::max({std::hypot(x.x, x.y) + rad - radius, bottom - (x.z - rad), x.z + rad - top});
     if (beyond > kMaxOverlap * 2.0 * rad)
-      throw fail(r.line, fmt::format("grain {} reaches {:.4g} mm beyond a vessel wall, {:.3g} % of its diameter; at most {:g} % "
+      throw fail(r.line, fmt::format("{} {} reaches {:.4g} mm beyond a vessel wall, {:.3g} % of its diameter; at most {:g} % "
                                      "is a packed state",
-                                     r.id, beyond * 1e3, 100 * beyond / (2.0 * rad), 100 * kMaxOverlap));
+                                     clump_file ? what : "grain", r.id, beyond * 1e3, 100 * beyond / (2.0 * rad), 100 * kMaxOverlap));
+    if (clump_file) continue;
     BallInit b;
     b.id = r.id;
     b.position = x;
@@ -248,7 +331,8 @@ Specimen parse_packed_specimen(const std::string& text, const std::string& sourc
     b.groups = grain_bit;
     sim.balls.add(b);
   }
-  check_overlaps(rows, source);
+  if (clump_file) sim.clumps.place_pebbles(sim.balls);
+  check_overlaps(spheres, source);
   sim.sort_balls_spatially();
   install_table(sim, packing_table(sim, p.contact, p.walls));
   sim.update_forces();

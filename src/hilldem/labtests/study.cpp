@@ -114,8 +114,20 @@ void validate(const StudySettings& s, const std::vector<CaseSpec>& cases) {
       !(m.linear_kratio > 0) || !(m.damp_con >= 0 && m.damp_con < 1) || !(m.density > 0))
     throw InputError("material properties out of range");
   if (s.jobs < 0 || s.jobs > 1024) throw InputError(fmt::format("--jobs must be in [0, 1024], got {}", s.jobs));
+  if (!s.genesis.clump_template.empty() && s.triaxial.density_scaling > 0)
+    throw InputError("density scaling does not apply to clumps (docs/clumps.md, Limits): give --density-scaling 0 with "
+                     "--clump-template");
   if (!s.specimen_file.empty()) {
-    load_packed_specimen(s.specimen_file);  // parse it now: a bad file stops before any work
+    // Parse it now: a bad file stops before any work.
+    const Specimen sp = load_packed_specimen(s.specimen_file);
+    const std::string& want = s.genesis.clump_template;
+    if (!want.empty() && sp.clump_template != want)
+      throw InputError(fmt::format("--clump-template {} and --specimen {}: the file's grains are {}", want, s.specimen_file,
+                                   sp.clump_template.empty() ? "balls" : "clumps of " + sp.clump_template));
+    if (!sp.clump_template.empty() && s.triaxial.density_scaling > 0)
+      throw InputError(fmt::format("density scaling does not apply to clumps (docs/clumps.md, Limits): the specimen {} has clumps "
+                                   "of {}",
+                                   s.specimen_file, sp.clump_template));
     for (const CaseSpec& c : cases)
       if (c.grading != cases.front().grading)
         throw InputError("--specimen gives one packed specimen: all cases must use its grading");
@@ -228,7 +240,9 @@ std::string StudyResult::summary_markdown() const {
   std::string out = head + "\n" + rule + "\n";
   for (const CaseResult& c : cases) {
     out += fmt::format("| {} | {} | {} | {:.4f} / {} | {} | {:.4f} / {} | {:.2f} | {:.2f} | {:.1f} | {:.3f} | {:.3f} |", c.spec.name(),
-                       to_string(c.packed_with), c.initial.grains, c.packed.porosity, interior_text(c.packed),
+                       c.clump_template.empty() ? std::string(to_string(c.packed_with))
+                                                : fmt::format("{} (clumps of {})", to_string(c.packed_with), c.clump_template),
+                       c.initial.grains, c.packed.porosity, interior_text(c.packed),
                        packing_change_text(c.phases), c.initial.porosity, interior_text(c.initial), c.packed.coordination,
                        c.initial.coordination, c.test.peak_q / 1e3, 100 * c.test.peak_strain, 100 * c.test.peak_volumetric_strain);
     for (std::size_t k = 0; k < nl; ++k) {
@@ -496,7 +510,10 @@ PackedResult make_packed(const StudySettings& settings, const std::string& gradi
     p.file = settings.specimen_file;
     if (log)
       *log << fmt::format("specimen {}: {} grains of {} packed at {:g} kPa (seed {})\n", settings.specimen_file,
-                          p.specimen.sim.balls.size(), p.specimen.grading, p.specimen.pressure / 1e3, p.specimen.seed);
+                          grain_count(p.specimen.sim), p.specimen.grading, p.specimen.pressure / 1e3, p.specimen.seed);
+    if (log && !p.specimen.clump_template.empty())
+      *log << fmt::format("specimen {}: grains are clumps of {} ({} pebbles, {})\n", settings.specimen_file,
+                          p.specimen.clump_template, p.specimen.sim.clumps.pebbles.size(), to_string(p.specimen.clump_size));
     if (log)
       *log << fmt::format("specimen {}: packed with {} contacts\n", settings.specimen_file, to_string(p.specimen.packed_with));
     if (p.specimen.grading != grading.name && log)
@@ -771,6 +788,7 @@ StudyResult run_study(const StudySettings& settings, const std::vector<CaseSpec>
     r.grading = p.report;
     r.packed = p.state;
     r.packed_with = p.specimen.packed_with;
+    r.clump_template = p.specimen.clump_template;
     r.packing_file = p.file;
     Specimen s = p.specimen;  // a copy: every case starts from the same packed state
     Class5Material m = settings.material;
