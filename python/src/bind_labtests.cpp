@@ -425,6 +425,10 @@ servo-controlled triaxial test and the Class 5 study, as `hilldem triaxial` runs
 classes with one attribute per setting (SI units: [m], [Pa], [1/s]; strains as fractions [-], not %);
 results are dicts of numbers, strings and numpy arrays (docs/python.md lists them with units).)");
 
+  py::enum_<SizeMeasure>(lab, "SizeMeasure", "What a clump's size [m] is (docs/clumps.md).")
+      .value("EqualVolumeDiameter", SizeMeasure::EqualVolumeDiameter, "the diameter of the sphere of equal volume (the default)")
+      .value("EnclosingDiameter", SizeMeasure::EnclosingDiameter,
+             "the diameter of the smallest sphere about the centre of mass that holds every pebble");
   py::enum_<GrainModel>(lab, "GrainModel", "Grain-grain contact model of a Class 5 material.")
       .value("Linear", GrainModel::Linear)
       .value("Hill", GrainModel::Hill);
@@ -536,7 +540,12 @@ rows. InputError naming the file, line and value on bad input.)");
       .def_readwrite("vessel_radius", &GenesisSpec::vessel_radius, "Vessel radius [m] (default the memo's 0.085; StudySettings' default 0.0425).")
       .def_readwrite("vessel_height", &GenesisSpec::vessel_height, "Vessel height [m] (default the memo's 0.240; StudySettings' default 0.120).")
       .def_readwrite("grain", &GenesisSpec::grain, "Class5Material whose density, E and nu the grains take.")
-      .def_readwrite("packing", &GenesisSpec::packing, "PackingSettings.");
+      .def_readwrite("packing", &GenesisSpec::packing, "PackingSettings.")
+      .def_readwrite("clump_template", &GenesisSpec::clump_template,
+                     "Grains as clumps of this named template (sphere, elongated2, elongated3, ellipsoid, cube, prism, slab, "
+                     "rock; docs/clumps.md), each scaled to its drawn size and turned at random from the seed; '' (the "
+                     "default): balls.")
+      .def_readwrite("clump_size", &GenesisSpec::clump_size, "SizeMeasure: what a clump's drawn size [m] is.");
   py::class_<TriaxialSettings>(lab, "TriaxialSettings", "The servo-controlled triaxial test (lab-tests.md §4).")
       .def(py::init<>(), "The header's defaults.")
       .def_readwrite("confinement", &TriaxialSettings::confinement, "Confining pressure sigma_c [Pa].")

@@ -82,12 +82,12 @@ TEST(ClumpGenesis, GrainsAreClumpsOfTheDrawnSizesAtRandomOrientations) {
 }
 
 TEST(ClumpGenesis, WhatDoesNotApplyIsRefused) {
-  GenesisSpec spec = clump_spec("cube");
+  GenesisSpec spec = clump_spec("dodecahedron");
   try {
     make_cloud(spec);
     FAIL() << "no error";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("unknown clump template 'cube'; known: sphere, elongated2, elongated3"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("unknown clump template 'dodecahedron'; known: sphere, elongated2, elongated3, ellipsoid, cube"), std::string::npos)
         << e.what();
   }
   StudySettings st;

@@ -170,8 +170,8 @@ endforeach()
 
 # Clumped grains (docs/clumps.md, "Specimens of clumps"): what does not apply is refused before any work.
 add_test(NAME cli.triaxial_unknown_clump_template_exits_2
-  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "unknown clump template 'cube'; known: sphere, elongated2, elongated3" --not-stdout "cloud"
-          2 $<TARGET_FILE:hilldem> triaxial --clump-template cube -o ${HILLDEM_TRIAXIAL_OUT}/clump1)
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "unknown clump template 'dodecahedron'; known: sphere, elongated2, elongated3, ellipsoid, cube" --not-stdout "cloud"
+          2 $<TARGET_FILE:hilldem> triaxial --clump-template dodecahedron -o ${HILLDEM_TRIAXIAL_OUT}/clump1)
 add_test(NAME cli.triaxial_clump_density_scaling_exits_2
   COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "density scaling does not apply to clumps" --not-stdout "cloud"
           2 $<TARGET_FILE:hilldem> triaxial --clump-template elongated2 --density-scaling 2 -o ${HILLDEM_TRIAXIAL_OUT}/clump2)

@@ -110,6 +110,26 @@ def test_genesis_from_python_is_the_clis(cli, source_dir, tmp_path):
     assert 0.2 < state["porosity"] < 0.6 and state["radial_stress"] == pytest.approx(150e3, rel=2e-2)
 
 
+def test_clump_genesis_from_python_is_the_clis(cli, source_dir, tmp_path):
+    """GenesisSpec.clump_template: grains as clumps, the CLI's --clump-template file to the byte."""
+    _, fine = mini_files(source_dir)
+    cli("triaxial", "--pack-only", "--grading", fine, "--scale", 0.15, "--seed", 42, "--threads", 1, "--clump-template",
+        "elongated2", "-q", "-o", tmp_path)
+    spec = lab.GenesisSpec()
+    spec.grading = lab.grading(str(fine))
+    spec.vessel_radius, spec.vessel_height = 0.085 * 0.15, 0.240 * 0.15
+    spec.packing.seed = 42
+    spec.clump_template = "elongated2"
+    assert spec.clump_size == lab.SizeMeasure.EqualVolumeDiameter
+    s = lab.pack_specimen(spec)
+    mine = tmp_path / "mine.csv"
+    s.save(mine, spec.packing)
+    assert mine.read_text() == (tmp_path / "specimens" / "fine_hill_packed.csv").read_text()
+    spec.clump_template = "dodecahedron"
+    with pytest.raises(hilldem.InputError, match="unknown clump template 'dodecahedron'"):
+        lab.pack_specimen(spec)
+
+
 def test_gradings(source_dir):
     c5b = lab.grading("C5b")
     assert len(c5b.bins) == 8 and sum(b.fraction for b in c5b.bins) == pytest.approx(1.0, abs=1e-3)
