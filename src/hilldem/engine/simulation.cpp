@@ -318,6 +318,7 @@ void Simulation::force_pass(double dt) {
   const PassWorld world{&balls, &walls,     &contacts, &table,      &settings,  &neighbours_,
                         &ball_kin_, &live_, &split_,   &hill_sets_, &stiffness_};
   pass_.run(world, PassOptions{dt, write_results_, steps, &thread_shares, balls_per_block});
+  if (domain) domain->after_forces(*this);
 }
 
 void Simulation::prepare_pass() {

@@ -9,6 +9,7 @@
 #include <string>
 #include <type_traits>
 
+#include "hilldem/core/error.hpp"
 #include "hilldem/engine/force_pass.hpp"
 
 namespace hilldem::parallel {
@@ -147,6 +148,14 @@ ContactStore sort_rows(ContactStore& rows, const std::vector<std::uint32_t>* glo
 Domain::Domain(MPI_Comm comm, Simulation& sim) : comm_(comm), sim_(&sim) {
   MPI_Comm_rank(comm_, &rank_);
   MPI_Comm_size(comm_, &size_);
+  if (size_ > 1 && !sim.clumps.empty())
+    throw InputError("clumps are not decomposed over MPI ranks yet (docs/mpi.md): run on one rank");
+  if (size_ > 1 && sim.settings.auto_timestep)
+    throw InputError("the automatic time step does not run decomposed over MPI ranks yet (docs/mpi.md): give "
+                     "[simulation] timestep in seconds (> 0), or run on one rank");
+  // The cycle state of a run that has cycled (a restored checkpoint), kept below.
+  CycleState cycled = sim.cycle_state();
+  const bool keep_cycle = !cycled.rebuild_needed && cycled.position_at_build.size() == sim.balls.size();
   // The skin from the radii (settings.skin 0) would be each rank's own mean: the whole run's instead.
   skin_given_ = sim.settings.skin;
   if (sim.settings.skin <= 0.0) sim.settings.skin = sim.skin();
@@ -195,7 +204,17 @@ Domain::Domain(MPI_Comm comm, Simulation& sim) : comm_(comm), sim_(&sim) {
   sim.contacts = sort_rows(rows, &global_);
   sim.balls = std::move(balls);
   make_lists(sim);
-  sim.domain = this;  // (the list no longer fits the balls: the next force pass detects afresh)
+  sim.domain = this;  // (unless kept below, the list no longer fits the balls: the next force pass detects afresh)
+  if (keep_cycle) {
+    // The rows here are every row of the owned balls (all of a ball's rows were between balls within
+    // the ghost width), so the local list is complete for them, and the next rebuild comes when some
+    // ball, on some rank, has travelled half the skin since the whole run's last one.
+    std::vector<Vec3> at(global_.size());
+    for (std::size_t i = 0; i < global_.size(); ++i) at[i] = cycled.position_at_build[global_[i]];
+    cycled.position_at_build = std::move(at);
+    cycled.rows_complete = true;
+    sim.restore_cycle_state(std::move(cycled));
+  }
 }
 
 Domain::~Domain() = default;
@@ -371,6 +390,37 @@ void Domain::before_rebuild(Simulation& sim) {
   owner_ = std::move(owner);
   make_lists(sim);
   ++bytes_.rebuilds;
+}
+
+void Domain::after_forces(Simulation& sim) {
+  if (sim.walls.walls.empty()) return;
+  // One active wall row of an owned ball: its key in global indices and its share (72 bytes).
+  struct Share {
+    std::uint32_t ball, wall;
+    WallShare share;
+  };
+  static_assert(std::is_trivially_copyable_v<Share>);
+  std::vector<Share> mine;
+  const ContactStore& rows = sim.contacts;
+  for (std::size_t c = 0; c < rows.size(); ++c) {
+    const ContactKey& k = rows.key[c];
+    if (k.kind != ContactKind::BallWall || !rows.active[c] || owner_[k.a] != rank_) continue;
+    mine.push_back({global_[k.a], k.b,
+                    wall_row_share(sim.walls.walls[k.b], rows, c, sim.balls.position[k.a], sim.balls.radius[k.a])});
+  }
+  const int bytes = static_cast<int>(mine.size() * sizeof(Share));
+  std::vector<int> counts(static_cast<std::size_t>(size_)), at(static_cast<std::size_t>(size_) + 1, 0);
+  MPI_Allgather(&bytes, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
+  for (int q = 0; q < size_; ++q) at[q + 1] = at[q] + counts[q];
+  wall_in_.resize(static_cast<std::size_t>(at[size_]));
+  MPI_Allgatherv(mine.data(), bytes, MPI_BYTE, wall_in_.data(), counts.data(), at.data(), MPI_BYTE, comm_);
+  bytes_.walls += static_cast<std::uint64_t>(bytes) * static_cast<std::uint64_t>(size_ - 1);
+  std::vector<Share> all(wall_in_.size() / sizeof(Share));
+  std::memcpy(all.data(), wall_in_.data(), wall_in_.size());
+  // The whole run's row order (ContactKey: kind, then ball, then wall), from zero.
+  std::sort(all.begin(), all.end(), [](const Share& x, const Share& y) { return x.ball != y.ball ? x.ball < y.ball : x.wall < y.wall; });
+  for (Wall& w : sim.walls.walls) clear_wall_sums(w);
+  for (const Share& s : all) add_wall_share(sim.walls.walls[s.wall], s.share);
 }
 
 Simulation Domain::gather() const {

@@ -10,7 +10,8 @@
 //
 // Per step (DomainHooks): after the law of motion each owner sends its balls' position, velocity and
 // spin to the ranks that ghost them (after_motion); the rebuild decision is the OR of the ranks'
-// (rebuild_anywhere); before a rebuild (before_rebuild) the balls go to their new owner and ghost
+// (rebuild_anywhere); after the force pass the walls' sums are made from every rank's owned rows in
+// the whole run's row order (after_forces); before a rebuild (before_rebuild) the balls go to their new owner and ghost
 // ranks with every column, and each row goes from the owner of its first ball to every rank that
 // will hold both its balls, with its history (the pattern of LAMMPS's fix neigh/history). The
 // sub-domains are cut again by Zoltan RCB, weighted by rows per ball, when the rows per rank are out
@@ -32,6 +33,7 @@ namespace hilldem::parallel {
 struct ExchangeBytes {
   std::uint64_t ghost = 0;      // after_motion: ghosts' motion
   std::uint64_t migration = 0;  // before_rebuild: balls and rows
+  std::uint64_t walls = 0;      // after_forces: the walls' shares of owned rows
   std::int64_t steps = 0, rebuilds = 0, repartitions = 0;
 };
 
@@ -41,7 +43,10 @@ class Domain final : public DomainHooks {
   static constexpr double kImbalance = 1.10;
 
   // Make `sim`, the whole run (the same on every rank: balls, walls, rows), this rank's part, and
-  // attach to it (sim.domain). sim must stay where it is while attached; a Simulation that outlives
+  // attach to it (sim.domain). A run that has cycled (its neighbour list built: a restored
+  // checkpoint) keeps its cycle state, each rank the positions at the last rebuild of its balls, so
+  // that it rebuilds when the whole run would. Throws InputError for what does not run decomposed
+  // over more than one rank: clumps, and the automatic time step (each rank's estimate is its own). sim must stay where it is while attached; a Simulation that outlives
   // its Domain is detached by setting sim.domain = nullptr (the destructor does not touch sim).
   Domain(MPI_Comm comm, Simulation& sim);
   ~Domain() override;
@@ -51,6 +56,9 @@ class Domain final : public DomainHooks {
   void after_motion(Simulation& sim) override;
   bool rebuild_anywhere(bool here) override;
   void before_rebuild(Simulation& sim) override;
+  // Every active wall row of an owned ball gives its share (wall_row_share) to every rank; each rank
+  // adds them all, by key (global ball index, wall), from zero: the whole run's sums, bitwise.
+  void after_forces(Simulation& sim) override;
 
   // The whole run's state on rank 0 (balls by global index, rows by key in global indices, the walls'
   // sums over all rows in row order); an empty Simulation on other ranks. Collective.
@@ -79,6 +87,7 @@ class Domain final : public DomainHooks {
   // after_motion's lists: per rank, the local balls sent (owned here, ghosted there) and received.
   std::vector<std::vector<std::uint32_t>> send_, recv_;
   ExchangeBytes bytes_;
+  std::vector<char> wall_in_;  // after_forces: every rank's shares
 
   void set_width(const Simulation& sim);
   void cut(const Simulation& sim, bool weighted);
