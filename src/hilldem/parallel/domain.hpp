@@ -48,7 +48,9 @@ class Domain final : public DomainHooks {
   // that it rebuilds when the whole run would. Throws InputError for what does not run decomposed
   // over more than one rank: clumps, and the automatic time step (each rank's estimate is its own). sim must stay where it is while attached; a Simulation that outlives
   // its Domain is detached by setting sim.domain = nullptr (the destructor does not touch sim).
-  Domain(MPI_Comm comm, Simulation& sim);
+  // min_reach [m]: the ghosts cover pairs this far apart beyond their radii (make_wet's gap), as they
+  // do the normal reach (proximity) and every existing row's gap.
+  Domain(MPI_Comm comm, Simulation& sim, double min_reach = 0.0);
   ~Domain() override;
   Domain(const Domain&) = delete;
   Domain& operator=(const Domain&) = delete;
@@ -61,8 +63,10 @@ class Domain final : public DomainHooks {
   void after_forces(Simulation& sim) override;
 
   // The whole run's state on rank 0 (balls by global index, rows by key in global indices, the walls'
-  // sums over all rows in row order); an empty Simulation on other ranks. Collective.
-  Simulation gather() const;
+  // sums over all rows in row order); an empty Simulation on other ranks. Collective. with_cycle:
+  // with the whole run's cycle state too (the positions at the last rebuild from the balls' owners),
+  // so that a checkpoint of it resumes with the next rebuild where the whole run makes it.
+  Simulation gather(bool with_cycle = false) const;
 
   int rank() const { return rank_; }
   int size() const { return size_; }
@@ -71,7 +75,8 @@ class Domain final : public DomainHooks {
   // The global index of local ball i.
   std::uint32_t global_index(std::size_t local) const { return global_[local]; }
   std::size_t ghosts() const { return global_.size() - owned(); }
-  // The ghost layer's width [m]: reach (proximity + skin) + twice the largest radius.
+  // The ghost layer's width [m]: the reach (the largest of proximity, min_reach and every existing
+  // row's gap, + skin) + twice the largest radius.
   double ghost_width() const { return width_; }
   const ExchangeBytes& bytes() const { return bytes_; }
 
@@ -79,6 +84,7 @@ class Domain final : public DomainHooks {
   MPI_Comm comm_;
   int rank_ = 0, size_ = 1;
   Simulation* sim_;
+  double min_reach_ = 0.0;           // [m]
   double skin_given_ = 0.0;          // the scenario's skin (0: from the radii, fixed at the attach)
   std::unique_ptr<RcbPartition> rcb_;
   double width_ = 0.0;               // [m]
