@@ -2,7 +2,8 @@
 # tests/mpi/tests.cmake: a scenario under `hilldem run` over MPI ranks against one process.
 #   scenario_over_ranks.sh HILLDEM WORKDIR SCENARIO run N     N ranks: every checkpoint's state digest
 #                                                             (the one after make_wet included), the
-#                                                             history and the probes are one process's
+#                                                             history, the probes and the snapshots
+#                                                             (files) are one process's
 #   scenario_over_ranks.sh HILLDEM WORKDIR SCENARIO resume    a checkpoint of 4 ranks (mid-stage, and the
 #                                                             one after make_wet) resumed on 2 ranks, 1
 #                                                             rank and without mpirun: the uninterrupted
@@ -37,6 +38,11 @@ case $mode in
     same "checkpoint digests on $n ranks" "$work/one.digests" "$work/ranks.digests"
     same "history on $n ranks" "$work/one/history.csv" "$work/ranks/history.csv"
     same "probes on $n ranks" "$work/one.probes" "$work/ranks.probes"
+    if [ -d "$work/one/snapshots" ]; then
+      if diff -r "$work/one/snapshots" "$work/ranks/snapshots" > /dev/null; then
+        echo "ok: snapshots on $n ranks ($(ls "$work/one/snapshots" | wc -l) files)"
+      else echo "FAIL: snapshots on $n ranks differ"; diff -rq "$work/one/snapshots" "$work/ranks/snapshots" | head; fail=1; fi
+    fi
     ;;
   resume)
     $MPIRUN -np 4 "$hilldem" run "$scenario" -q -o "$work/four" > /dev/null || { echo "FAIL: the run on 4 ranks"; exit 1; }

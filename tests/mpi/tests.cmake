@@ -15,15 +15,19 @@ foreach(ranks 1 2 3 4)
   set_tests_properties(mpi.bench_digest_${ranks}_ranks mpi.sliding_across_ranks_${ranks}_ranks
     PROPERTIES TIMEOUT 300 LABELS mpi ENVIRONMENT "OMP_NUM_THREADS=1")
 endforeach()
-# A wet hill bed in a box under a servo lid (make_wet, set_servo, histories, probes, checkpoints) under
-# `hilldem run` over N ranks: every checkpoint's state digest, the history and the probes are one
-# process's.
+# Scenarios under `hilldem run` over N ranks: every checkpoint's state digest (the one after
+# make_wet included), the history and the probes are one process's. A wet hill bed in a box under a
+# servo lid (make_wet, set_servo, histories, probes, checkpoints), and a small triaxial test.
 set(HILLDEM_MPI_SCENARIO bash ${CMAKE_CURRENT_SOURCE_DIR}/mpi/scenario_over_ranks.sh $<TARGET_FILE:hilldem>)
 foreach(ranks 1 2 3 4)
   add_test(NAME mpi.wet_servo_run_${ranks}_ranks
     COMMAND ${HILLDEM_MPI_SCENARIO} ${CMAKE_CURRENT_BINARY_DIR}/mpi_wet_servo_${ranks}
             ${CMAKE_CURRENT_SOURCE_DIR}/mpi/wet_servo_box.toml run ${ranks})
-  list(APPEND HILLDEM_MPI_SCENARIO_TESTS mpi.wet_servo_run_${ranks}_ranks)
+  # A small triaxial test: a radial servo on the cell and an axial one on the top platen.
+  add_test(NAME mpi.triaxial_servos_run_${ranks}_ranks
+    COMMAND ${HILLDEM_MPI_SCENARIO} ${CMAKE_CURRENT_BINARY_DIR}/mpi_triaxial_${ranks}
+            ${CMAKE_CURRENT_SOURCE_DIR}/mpi/triaxial_servos.toml run ${ranks})
+  list(APPEND HILLDEM_MPI_SCENARIO_TESTS mpi.wet_servo_run_${ranks}_ranks mpi.triaxial_servos_run_${ranks}_ranks)
 endforeach()
 # Its checkpoints from 4 ranks (after make_wet, and in the middle of a stage) resumed on 2 ranks, on
 # 1 and without mpirun: the uninterrupted run's final digest, history and probes.
