@@ -368,6 +368,7 @@ double Simulation::estimate_timestep() const {
       stiffness_.of_ball(clumps.ball[k], balls, contacts, neighbours_, k_tran[k], k_rot[k]);
     crit = std::min(crit, std::sqrt(clumps.critical_timestep2(k_tran, k_rot)));
   }
+  if (domain) crit = domain->min_over_ranks(crit);  // (+inf where a rank has no contact)
   return std::isfinite(crit) ? settings.timestep_safety * crit : 0.0;
 }
 

@@ -426,12 +426,10 @@ class Runner {
         const Stage& s = sc_.stages[k];
         const bool moves_balls = s.type == StageType::Translate || s.type == StageType::Rotate ||
                                  (s.type == StageType::Set && !s.sel.balls.empty());
-        const bool auto_dt = s.type == StageType::SetSimulation && s.timestep && *s.timestep == 0.0;
-        if (moves_balls || auto_dt)
-          throw InputError(fmt::format("{}: {} does not run decomposed over MPI ranks yet (docs/mpi.md): run it on one "
-                                       "rank",
-                                       stage_head(sc_, k), moves_balls ? "a stage that sets balls' motion or position"
-                                                                       : "the automatic time step (timestep = 0)"));
+        if (moves_balls)
+          throw InputError(fmt::format("{}: a stage that sets balls' motion or position does not run decomposed over "
+                                       "MPI ranks yet (docs/mpi.md): run it on one rank",
+                                       stage_head(sc_, k)));
       }
     double reach = 0.0;  // [m]
     for (const Stage& s : sc_.stages)

@@ -73,8 +73,8 @@ struct RunOptions {
   // (RunResult::halted; no stage-end outputs). Empty: never asked.
   std::function<bool()> stop_requested;
   // The run over MPI ranks this process is one rank of (null: the whole run here). Over more than
-  // one rank, stages that impose a ball's motion or position (translate, rotate, set on balls) and
-  // the automatic time step are refused (InputError).
+  // one rank, stages that impose a ball's motion or position (translate, rotate, set on balls) are
+  // refused (InputError).
   RunDecomposition* decomposition = nullptr;
 };
 

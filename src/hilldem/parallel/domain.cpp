@@ -150,9 +150,6 @@ Domain::Domain(MPI_Comm comm, Simulation& sim, double min_reach) : comm_(comm), 
   MPI_Comm_size(comm_, &size_);
   if (size_ > 1 && !sim.clumps.empty())
     throw InputError("clumps are not decomposed over MPI ranks yet (docs/mpi.md): run on one rank");
-  if (size_ > 1 && sim.settings.auto_timestep)
-    throw InputError("the automatic time step does not run decomposed over MPI ranks yet (docs/mpi.md): give "
-                     "[simulation] timestep in seconds (> 0), or run on one rank");
   // The cycle state of a run that has cycled (a restored checkpoint), kept below.
   CycleState cycled = sim.cycle_state();
   const bool keep_cycle = !cycled.rebuild_needed && cycled.position_at_build.size() == sim.balls.size();
@@ -429,6 +426,14 @@ void Domain::after_forces(Simulation& sim) {
   std::sort(all.begin(), all.end(), [](const Share& x, const Share& y) { return x.ball != y.ball ? x.ball < y.ball : x.wall < y.wall; });
   for (Wall& w : sim.walls.walls) clear_wall_sums(w);
   for (const Share& s : all) add_wall_share(sim.walls.walls[s.wall], s.share);
+}
+
+double Domain::min_over_ranks(double x) {
+  // A ghost's stiffness sums are over part of its rows, each term ≥ 0, so never above its owner's
+  // (rounding is monotonic): its m/k is never below, and the minimum over the ranks is that over
+  // the owned balls, the whole run's.
+  MPI_Allreduce(MPI_IN_PLACE, &x, 1, MPI_DOUBLE, MPI_MIN, comm_);
+  return x;
 }
 
 Simulation Domain::gather(bool with_cycle) const {

@@ -45,8 +45,7 @@ class Domain final : public DomainHooks {
   // Make `sim`, the whole run (the same on every rank: balls, walls, rows), this rank's part, and
   // attach to it (sim.domain). A run that has cycled (its neighbour list built: a restored
   // checkpoint) keeps its cycle state, each rank the positions at the last rebuild of its balls, so
-  // that it rebuilds when the whole run would. Throws InputError for what does not run decomposed
-  // over more than one rank: clumps, and the automatic time step (each rank's estimate is its own). sim must stay where it is while attached; a Simulation that outlives
+  // that it rebuilds when the whole run would. Throws InputError for clumps over more than one rank. sim must stay where it is while attached; a Simulation that outlives
   // its Domain is detached by setting sim.domain = nullptr (the destructor does not touch sim).
   // min_reach [m]: the ghosts cover pairs this far apart beyond their radii (make_wet's gap), as they
   // do the normal reach (proximity) and every existing row's gap.
@@ -61,6 +60,7 @@ class Domain final : public DomainHooks {
   // Every active wall row of an owned ball gives its share (wall_row_share) to every rank; each rank
   // adds them all, by key (global ball index, wall), from zero: the whole run's sums, bitwise.
   void after_forces(Simulation& sim) override;
+  double min_over_ranks(double x) override;
 
   // The whole run's state on rank 0 (balls by global index, rows by key in global indices, the walls'
   // sums over all rows in row order); an empty Simulation on other ranks. Collective. with_cycle:
