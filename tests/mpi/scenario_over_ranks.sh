@@ -6,8 +6,9 @@
 #                                                             (files) are one process's
 #   scenario_over_ranks.sh HILLDEM WORKDIR SCENARIO resume    a checkpoint of 4 ranks (mid-stage, and the
 #                                                             one after make_wet) resumed on 2 ranks, 1
-#                                                             rank and without mpirun: the uninterrupted
-#                                                             run's final digest and history
+#                                                             rank and without mpirun, and one of one
+#                                                             process resumed on 3 ranks: the
+#                                                             uninterrupted run's final digest and history
 # MPIRUN (environment): the launcher command line, e.g. "mpiexec --allow-run-as-root --oversubscribe".
 set -u
 hilldem=$1 work=$2 scenario=$3 mode=$4
@@ -62,6 +63,13 @@ case $mode in
         same "probes resumed on $how" "$work/one.probes" "$out.probes"
       done
     done
+    # And the one-process run's checkpoint resumed on 3 ranks.
+    out="$work/resumed-one-3"
+    $MPIRUN -np 3 "$hilldem" resume "$work/one/checkpoints/ckpt-000009.hdc" -q -o "$out" > "$out.out" || { echo "FAIL: resume on 3"; fail=1; }
+    got=$(tail -1 <(digests "$out") | cut -d' ' -f2-)
+    if [ "$got" != "$final" ]; then echo "FAIL: one process's checkpoint resumed on 3 ranks: $got, uninterrupted: $final"; fail=1
+    else echo "ok: one process's checkpoint resumed on 3 ranks: $got"; fi
+    same "history resumed on 3" "$work/one/history.csv" "$out/history.csv"
     ;;
 esac
 exit $fail
