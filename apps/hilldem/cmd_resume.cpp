@@ -9,8 +9,19 @@
 #include "hilldem/io/checkpoint.hpp"
 #include "hilldem/io/runner.hpp"
 #include "hilldem/io/stop_signal.hpp"
+#ifdef HILLDEM_MPI
+#include "hilldem/parallel/mpi_world.hpp"
+#include "hilldem/parallel/run_mpi.hpp"
+#endif
 
 namespace hilldem::cli {
+
+std::unique_ptr<RunDecomposition> decomposed_run() {
+#ifdef HILLDEM_MPI
+  if (parallel::world() != MPI_COMM_NULL) return std::make_unique<parallel::RunOverRanks>(parallel::world());
+#endif
+  return nullptr;
+}
 
 int report_stop(int signal, std::int64_t step, double time, const std::string& checkpoint, const std::string& checkpoint_dir) {
   std::cout.flush();
@@ -41,14 +52,20 @@ Command add_resume_command(CLI::App& app) {
   cmd->add_flag("-q,--quiet", o->quiet, "no stage lines or progress");
   return {cmd, [o, output] {
             if (output->count() > 0 && o->output.empty()) throw InputError("-o: the output folder name is empty");
-            if (!o->quiet) set_state_io_log(&std::cerr);
+            Scenario sc;
+            // (Over MPI ranks every rank resumes its part of the run; rank 0 writes and prints.)
+            const std::unique_ptr<RunDecomposition> ranks = decomposed_run();
+            const bool root = !ranks || ranks->rank() == 0;
+            const bool quiet = o->quiet || !root;
+            if (!quiet) set_state_io_log(&std::cerr);
             install_stop_handlers();
             RunOptions opt;
-            opt.quiet = o->quiet;
+            opt.quiet = quiet;
             opt.output_dir = o->output;
-            Scenario sc;
-            if (!o->quiet) std::cout << "hilldem resume " << o->path << "\n";
+            opt.decomposition = ranks.get();
+            if (!quiet) std::cout << "hilldem resume " << o->path << "\n";
             const RunResult res = resume_scenario(o->path, sc, opt, std::cout);
+            if (!root) return res.stopped_by ? 128 + res.stopped_by : 0;
             if (res.stopped_by) return report_stop(res.stopped_by, sc.sim.steps, sc.sim.time, res.last_checkpoint, res.checkpoint_dir);
             if (!o->quiet)
               std::cout << (res.already_complete ? "the run had already finished; nothing to do\n"

@@ -33,13 +33,19 @@ void check_output_folder(const std::string& file, const std::string& scenario_di
 int run(const Options& o) {
   Scenario sc = load_scenario_file(o.file);
   check_output_folder(o.file, sc.output_dir, o);
+  // (Over MPI ranks every rank runs its part of the scenario; rank 0 writes and prints.)
+  const std::unique_ptr<RunDecomposition> ranks = decomposed_run();
+  const bool root = !ranks || ranks->rank() == 0;
+  const bool quiet = o.quiet || !root;
   RunOptions opt;
-  opt.quiet = o.quiet;
+  opt.quiet = quiet;
   opt.output_dir = o.output;
-  if (!o.quiet) std::cout << "hilldem run " << o.file << (sc.title.empty() ? "" : ": " + sc.title) << "\n";
-  if (!o.quiet) set_state_io_log(&std::cerr);
+  opt.decomposition = ranks.get();
+  if (!quiet) std::cout << "hilldem run " << o.file << (sc.title.empty() ? "" : ": " + sc.title) << "\n";
+  if (!quiet) set_state_io_log(&std::cerr);
   install_stop_handlers();
   const RunResult res = run_scenario(sc, opt, std::cout);
+  if (!root) return res.stopped_by ? 128 + res.stopped_by : 0;
   if (res.stopped_by) return report_stop(res.stopped_by, sc.sim.steps, sc.sim.time, res.last_checkpoint, res.checkpoint_dir);
   if (!res.probes.empty()) {
     std::cout << fmt::format("{:<12} {:<26} {:<22} {:>16} {}\n", "label", "quantity", "target", "value", "unit");

@@ -12,7 +12,15 @@
 
 #include "hilldem/core/error.hpp"
 
+namespace hilldem {
+class RunDecomposition;  // io/runner.hpp
+}
+
 namespace hilldem::cli {
+
+// The run over MPI ranks when an MPI launcher started this process (docs/mpi.md; the MPI build
+// only), else null: RunOptions::decomposition of 'run' and 'resume'.
+std::unique_ptr<RunDecomposition> decomposed_run();
 
 struct Command {
   CLI::App* sub = nullptr;

@@ -62,9 +62,10 @@ int main(int argc, char** argv) {
     for (const Command& c : commands)
       if (c.sub && *c.sub) {
 #ifdef HILLDEM_MPI
-        if (g_size > 1 && c.sub->get_name() != "bench")
-          throw hilldem::InputError("'" + c.sub->get_name() + "' does not run decomposed over MPI ranks yet (only "
-                                    "'bench' does, docs/mpi.md): run it without mpirun, or with -np 1");
+        const std::string name = c.sub->get_name();
+        if (g_size > 1 && name != "bench" && name != "run" && name != "resume")
+          throw hilldem::InputError("'" + name + "' does not run decomposed over MPI ranks yet (only 'bench', 'run' "
+                                    "and 'resume' do, docs/mpi.md): run it without mpirun, or with -np 1");
 #endif
         return c.run();
       }

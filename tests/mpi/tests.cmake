@@ -15,6 +15,42 @@ foreach(ranks 1 2 3 4)
   set_tests_properties(mpi.bench_digest_${ranks}_ranks mpi.sliding_across_ranks_${ranks}_ranks
     PROPERTIES TIMEOUT 300 LABELS mpi ENVIRONMENT "OMP_NUM_THREADS=1")
 endforeach()
+# Scenarios under `hilldem run` over N ranks: every checkpoint's state digest (the one after
+# make_wet included), the history and the probes are one process's. A wet hill bed in a box under a
+# servo lid (make_wet, set_servo, histories, probes, checkpoints), and a small triaxial test.
+set(HILLDEM_MPI_SCENARIO bash ${CMAKE_CURRENT_SOURCE_DIR}/mpi/scenario_over_ranks.sh $<TARGET_FILE:hilldem>)
+foreach(ranks 1 2 3 4)
+  add_test(NAME mpi.wet_servo_run_${ranks}_ranks
+    COMMAND ${HILLDEM_MPI_SCENARIO} ${CMAKE_CURRENT_BINARY_DIR}/mpi_wet_servo_${ranks}
+            ${CMAKE_CURRENT_SOURCE_DIR}/mpi/wet_servo_box.toml run ${ranks})
+  # A small triaxial test: a radial servo on the cell and an axial one on the top platen.
+  add_test(NAME mpi.triaxial_servos_run_${ranks}_ranks
+    COMMAND ${HILLDEM_MPI_SCENARIO} ${CMAKE_CURRENT_BINARY_DIR}/mpi_triaxial_${ranks}
+            ${CMAKE_CURRENT_SOURCE_DIR}/mpi/triaxial_servos.toml run ${ranks})
+  list(APPEND HILLDEM_MPI_SCENARIO_TESTS mpi.wet_servo_run_${ranks}_ranks mpi.triaxial_servos_run_${ranks}_ranks)
+endforeach()
+# examples/assembly_27.toml (hill grains in a box of facets, the automatic time step, solve) on 2 and 4.
+foreach(ranks 2 4)
+  add_test(NAME mpi.assembly_27_run_${ranks}_ranks
+    COMMAND ${HILLDEM_MPI_SCENARIO} ${CMAKE_CURRENT_BINARY_DIR}/mpi_assembly_27_${ranks}
+            ${PROJECT_SOURCE_DIR}/examples/assembly_27.toml run ${ranks})
+  list(APPEND HILLDEM_MPI_SCENARIO_TESTS mpi.assembly_27_run_${ranks}_ranks)
+endforeach()
+# The wet bed's checkpoints from 4 ranks (after make_wet, and in the middle of a stage) resumed on 2 ranks, on
+# 1 and without mpirun: the uninterrupted run's final digest, history and probes.
+add_test(NAME mpi.checkpoint_of_4_ranks_resumes_on_2_and_1
+  COMMAND ${HILLDEM_MPI_SCENARIO} ${CMAKE_CURRENT_BINARY_DIR}/mpi_wet_servo_resume
+          ${CMAKE_CURRENT_SOURCE_DIR}/mpi/wet_servo_box.toml resume)
+list(APPEND HILLDEM_MPI_SCENARIO_TESTS mpi.checkpoint_of_4_ranks_resumes_on_2_and_1)
+string(REPLACE ";" " " HILLDEM_MPIRUN_LINE "${HILLDEM_MPIRUN}")
+set_tests_properties(${HILLDEM_MPI_SCENARIO_TESTS} PROPERTIES TIMEOUT 300 LABELS mpi
+  ENVIRONMENT "OMP_NUM_THREADS=1;MPIRUN=${HILLDEM_MPIRUN_LINE}")
+# A stage that imposes balls' motion does not run decomposed yet: said once (rank 0), exit status 2.
+add_test(NAME mpi.translate_over_ranks_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "sets balls' motion or position does not run decomposed"
+          2 ${HILLDEM_MPIRUN} -np 2 $<TARGET_FILE:hilldem> run -q ${PROJECT_SOURCE_DIR}/examples/two_grains_shear_dashpot.toml
+          -o ${CMAKE_CURRENT_BINARY_DIR}/mpi_translate)
+set_tests_properties(mpi.translate_over_ranks_exits_2 PROPERTIES TIMEOUT 120 LABELS mpi)
 # Commands that do not run decomposed yet say so once, with exit status 2.
 add_test(NAME mpi.run_on_two_ranks_exits_2
   COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "does not run decomposed"

@@ -174,13 +174,22 @@ void ForcePass::add_wall_rows(std::size_t k0, std::size_t k1) {
   }
 }
 
-void add_wall_row(Wall& w, const ContactStore& contacts, std::size_t c, const Vec3& position, double radius) {
+WallShare wall_row_share(const Wall& w, const ContactStore& contacts, std::size_t c, const Vec3& position, double radius) {
   const Vec3 point = position + contacts.normal[c] * (radius + 0.5 * contacts.gap[c]);
-  w.force += contacts.force[c];
-  w.moment += cross(point - w.rotation_center, contacts.force[c]) + contacts.moment_state[c];  // (+ M_c: rrlinear)
-  w.normal_force += dot(contacts.force[c], contacts.normal[c]);
-  w.normal_stiffness += wall_normal_stiffness(contacts, c);
+  return {contacts.force[c], cross(point - w.rotation_center, contacts.force[c]) + contacts.moment_state[c],  // (+ M_c: rrlinear)
+          dot(contacts.force[c], contacts.normal[c]), wall_normal_stiffness(contacts, c)};
+}
+
+void add_wall_share(Wall& w, const WallShare& s) {
+  w.force += s.force;
+  w.moment += s.moment;
+  w.normal_force += s.normal_force;
+  w.normal_stiffness += s.normal_stiffness;
   ++w.active_contacts;
+}
+
+void add_wall_row(Wall& w, const ContactStore& contacts, std::size_t c, const Vec3& position, double radius) {
+  add_wall_share(w, wall_row_share(w, contacts, c, position, radius));
 }
 
 void clear_wall_sums(Wall& w) {

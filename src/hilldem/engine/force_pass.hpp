@@ -58,6 +58,16 @@ struct PassWorld {
 // `radius` [m]. A wall's sums are these shares added in row order from zero: the force pass, and the
 // ranks of a domain decomposition over the rows of all ranks (parallel/domain.cpp).
 void add_wall_row(Wall& w, const ContactStore& contacts, std::size_t c, const Vec3& position, double radius);
+// That share, and its addition: add_wall_row(w, ...) is add_wall_share(w, wall_row_share(w, ...)),
+// so that a rank can send the shares of its balls' rows to the others (parallel/domain.cpp).
+struct WallShare {
+  Vec3 force;                     // [N]
+  Vec3 moment;                    // [N m] about the wall's rotation centre
+  double normal_force = 0.0;      // [N]
+  double normal_stiffness = 0.0;  // [N/m]
+};
+WallShare wall_row_share(const Wall& w, const ContactStore& contacts, std::size_t c, const Vec3& position, double radius);
+void add_wall_share(Wall& w, const WallShare& s);
 // The sums add_wall_row adds to, zeroed.
 void clear_wall_sums(Wall& w);
 

@@ -318,6 +318,7 @@ void Simulation::force_pass(double dt) {
   const PassWorld world{&balls, &walls,     &contacts, &table,      &settings,  &neighbours_,
                         &ball_kin_, &live_, &split_,   &hill_sets_, &stiffness_};
   pass_.run(world, PassOptions{dt, write_results_, steps, &thread_shares, balls_per_block});
+  if (domain) domain->after_forces(*this);
 }
 
 void Simulation::prepare_pass() {
@@ -367,6 +368,7 @@ double Simulation::estimate_timestep() const {
       stiffness_.of_ball(clumps.ball[k], balls, contacts, neighbours_, k_tran[k], k_rot[k]);
     crit = std::min(crit, std::sqrt(clumps.critical_timestep2(k_tran, k_rot)));
   }
+  if (domain) crit = domain->min_over_ranks(crit);  // (+inf where a rank has no contact)
   return std::isfinite(crit) ? settings.timestep_safety * crit : 0.0;
 }
 

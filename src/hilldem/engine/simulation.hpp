@@ -40,7 +40,7 @@ class Simulation;
 
 // One rank's part of a domain decomposition (parallel/domain.hpp, docs/mpi.md): the Simulation then
 // holds the balls this rank owns and the ghost copies of its neighbours' balls near them, in the
-// relative order of the whole run, and calls these at the three points of the cycle where ranks
+// relative order of the whole run, and calls these at the points of the cycle where ranks
 // must agree. Null (the default): the Simulation is the whole run.
 class DomainHooks {
  public:
@@ -52,6 +52,12 @@ class DomainHooks {
   // Before a rebuild (columns and rows current): balls move to their new owners with their rows,
   // and the ghosts are made again. May replace every ball and row of `sim`.
   virtual void before_rebuild(Simulation& sim) = 0;
+  // After the force pass: the walls' sums made the whole run's (each rank's pass counted its ghosts'
+  // wall rows too), the same on every rank.
+  virtual void after_forces(Simulation& sim) = 0;
+  // The smallest of every rank's x (exact in any order): the whole run's critical time step [s] from
+  // each rank's (spec §4; a ghost's, from part of its rows, is never below its owner's).
+  virtual double min_over_ranks(double x) = 0;
 };
 
 class Simulation {

@@ -87,6 +87,18 @@ OutputOverrides& output_overrides() {
   return o;
 }
 
+namespace {
+// The quantity on `sim`: the scenario's Simulation, or (over MPI ranks) the gathered whole run.
+double evaluate_on(const Scenario& sc, const Simulation& sim, const Quantity& q, int servo) {
+  if (servo < 0) return evaluate(sim, q);
+  const Servo& s = sc.servos[static_cast<std::size_t>(servo)].servo;
+  if (q.field == "stress") return s.stress(sim);
+  if (q.field == "target_stress") return s.settings.target_stress;
+  if (q.field == "speed") return s.speed();
+  return s.enabled ? 1.0 : 0.0;  // "enabled"
+}
+}  // namespace
+
 double evaluate(const Scenario& sc, const Quantity& q, int servo) {
   if (servo < 0) return evaluate(sc.sim, q);
   const Servo& s = sc.servos[static_cast<std::size_t>(servo)].servo;
@@ -133,7 +145,7 @@ class HistoryWriter {
   void sample(const Simulation& sim) {
     std::string row = fmt::format("{},{:.9e}", sim.steps, sim.time);
     for (const History& h : sc_.histories) {
-      const double v = evaluate(sc_, h.quantity, h.servo);
+      const double v = evaluate_on(sc_, sim, h.quantity, h.servo);
       row += ",";
       if (std::isfinite(v)) row += fmt::format("{:.9e}", v);
     }
@@ -319,10 +331,13 @@ double progress_interval(const RunOptions& o) {
 class Runner {
  public:
   Runner(Scenario& sc, const RunOptions& options, std::ostream& log)
-      : sc_(sc), sim_(sc.sim), opt_(options), log_(log),
+      : sc_(sc), sim_(sc.sim), opt_(options), log_(log), dec_(options.decomposition),
+        root_(!dec_ || dec_->rank() == 0),
         progress_(options.progress_stream ? *options.progress_stream : std::cerr,
-                  options.quiet ? ProgressMode::Off : options.progress,
-                  !options.progress_stream && ::isatty(STDERR_FILENO) == 1, progress_interval(options)) {}
+                  options.quiet || !root_ ? ProgressMode::Off : options.progress,
+                  !options.progress_stream && ::isatty(STDERR_FILENO) == 1, progress_interval(options)) {
+    if (!root_) opt_.quiet = true;  // (lines from rank 0 only)
+  }
 
   ~Runner() {
     sim_.observers.clear();
@@ -331,10 +346,11 @@ class Runner {
 
   // Fresh run from the first stage.
   RunResult run(const std::string& dir) {
+    decompose();
     open_outputs(dir, nullptr);
     sim_.update_forces();
-    if (history_) history_->sample(sim_);
-    if (snapshots_) snapshots_->write(sim_);
+    if (!result_.history_path.empty()) sample_history();
+    if (!result_.snapshot_dir.empty()) write_snapshot(false);
     checkpoint("start");  // a run killed before its first periodic checkpoint can still be resumed
     return run_stages();
   }
@@ -343,6 +359,7 @@ class Runner {
   // `source_dir`: the folder whose outputs the checkpoint continues ("": `dir` itself).
   RunResult resume(const CheckpointReader& r, const std::string& dir, const std::string& source_dir) {
     source_dir_ = source_dir;
+    decompose();
     read_position(r);
     last_checkpoint_stage_ = pos_.stage;  // the checkpoint resumed from is at this position
     open_outputs(dir, &r);
@@ -398,12 +415,100 @@ class Runner {
   }
 
  private:
+  // ---- over MPI ranks ----
+
+  // This rank's part of the run (RunOptions::decomposition), after refusing what does not run
+  // decomposed. The ghosts cover the widest make_wet gap of the scenario.
+  void decompose() {
+    if (!dec_) return;
+    if (dec_->size() > 1)
+      for (std::size_t k = 0; k < sc_.stages.size(); ++k) {
+        const Stage& s = sc_.stages[k];
+        const bool moves_balls = s.type == StageType::Translate || s.type == StageType::Rotate ||
+                                 (s.type == StageType::Set && !s.sel.balls.empty());
+        if (moves_balls)
+          throw InputError(fmt::format("{}: a stage that sets balls' motion or position does not run decomposed over "
+                                       "MPI ranks yet (docs/mpi.md): run it on one rank",
+                                       stage_head(sc_, k)));
+      }
+    double reach = 0.0;  // [m]
+    for (const Stage& s : sc_.stages)
+      if (s.type == StageType::MakeWet) reach = std::max(reach, s.wet_gap);
+    dec_->attach(sim_, reach);
+  }
+
+  // Whether rank 0's answer is yes (decisions on the clock must be the same on every rank).
+  bool agreed(bool here) { return dec_ ? dec_->from_root(static_cast<std::int64_t>(here)) != 0 : here; }
+
+  // The stop signal (io/stop_signal.hpp) any rank got, 0: none.
+  int stop_signal() {
+    const int s = stop_requested();
+    return dec_ ? static_cast<int>(dec_->max(s)) : s;
+  }
+
+  // Existing contacts of the whole run (wet_only: wet hill contacts), each counted by the owner of
+  // its first ball.
+  std::size_t count_contacts(bool wet_only) {
+    if (!dec_ && !wet_only) return sim_.contact_count();
+    const ContactStore& c = sim_.contacts;
+    std::uint64_t n = 0;
+    for (std::size_t k = 0; k < c.size(); ++k)
+      n += c.exists[k] && (!wet_only || (c.model[k] == ModelKind::Hill && c.moisture[k] == Moisture::Wet)) &&
+           (!dec_ || dec_->owns(c.key[k].a));
+    return static_cast<std::size_t>(dec_ ? dec_->sum(n) : n);
+  }
+
+  // PFC's mean unbalanced-force ratio of the whole run (over ranks: of the gathered run, on rank 0).
+  double unbalanced_ratio() {
+    if (!dec_) return sim_.mean_unbalanced_ratio();
+    const Simulation whole = dec_->gather(false);
+    return dec_->from_root(root_ ? whole.mean_unbalanced_ratio() : 0.0);
+  }
+
+  void sample_history() {
+    if (!dec_) return history_->sample(sim_);
+    const Simulation whole = dec_->gather(false);
+    if (root_) history_->sample(whole);
+  }
+
+  void write_snapshot(bool stage_end) {
+    if (!dec_) return snapshots_->write(sim_, stage_end);
+    const Simulation whole = dec_->gather(false);
+    if (root_) snapshots_->write(whole, stage_end);
+  }
+
   // ---- outputs ----
 
   void open_outputs(const std::string& dir, const CheckpointReader* resume) {
     for (ScenarioServo& s : sc_.servos)
       sim_.controllers.push_back([servo = &s.servo](Simulation& sim, double dt) { servo->control(sim, dt); });
     if (!opt_.write_files || dir.empty()) return;
+    if (!dec_) {
+      open_files(dir, resume);
+    } else {
+      // Rank 0 opens the files; a problem with them is every rank's error (reported once, by rank 0).
+      std::string error;
+      if (root_) try {
+          open_files(dir, resume);
+        } catch (const InputError& e) {
+          error = e.what();
+        }
+      error = dec_->from_root(error);
+      if (!error.empty()) throw InputError(error);
+      // The other ranks take part in each write (it gathers the state), so they know which there are.
+      if (!sc_.histories.empty()) result_.history_path = (fs::path(dir) / sc_.history_file).string();
+      if (sc_.snapshots.enabled) result_.snapshot_dir = (fs::path(dir) / sc_.snapshots.folder).string();
+      if (sc_.checkpoints.enabled) result_.checkpoint_dir = (fs::path(dir) / kCheckpointFolder).string();
+    }
+    if (!result_.history_path.empty()) {
+      const std::int64_t every = sc_.history_every;
+      sim_.observers.push_back([this, every](const Simulation& s) {
+        if (s.steps % every == 0) sample_history();
+      });
+    }
+  }
+
+  void open_files(const std::string& dir, const CheckpointReader* resume) {
     std::error_code ec;
     // The folder is ours until the run ends (a second run or resume on it is refused), which also
     // makes it safe to remove what killed runs left half written.
@@ -454,10 +559,6 @@ class Runner {
       } else {
         history_ = std::make_unique<HistoryWriter>(sc_, result_.history_path);
       }
-      const std::int64_t every = sc_.history_every;
-      sim_.observers.push_back([h = history_.get(), every](const Simulation& s) {
-        if (s.steps % every == 0) h->sample(s);
-      });
     }
     if (sc_.snapshots.enabled) {
       result_.snapshot_dir = (fs::path(dir) / sc_.snapshots.folder).string();
@@ -510,13 +611,14 @@ class Runner {
 
   std::uint64_t flush_history() { return history_ ? history_->flush() : 0; }
 
-  void write_run_sections(CheckpointWriter& w, const std::string& kind, const std::string& message) {
+  // sim: the run's state (over MPI ranks, the gathered whole run).
+  void write_run_sections(CheckpointWriter& w, const std::string& kind, const std::string& message, const Simulation& sim) {
     {
       SectionWriter& s = w.section(kMetaSection);
       s.str(kind);
       s.str(message);
       s.i64(static_cast<std::int64_t>(std::time(nullptr)));
-      s.str(state_digest(sim_));
+      s.str(state_digest(sim));
     }
     {
       SectionWriter& s = w.section("run.scenario");
@@ -582,7 +684,7 @@ class Runner {
         write_servo(s, sv.servo);
       }
     }
-    write_simulation(w, sim_);
+    write_simulation(w, sim);
   }
 
   void checkpoint(const char* kind) {
@@ -590,9 +692,22 @@ class Runner {
     ++seq_;
     const std::string path = (fs::path(result_.checkpoint_dir) / fmt::format("ckpt-{:06}.hdc", seq_)).string();
     try {
-      CheckpointWriter w;
-      write_run_sections(w, kind, "");
-      w.write_file(path);
+      if (dec_) {
+        // One file, in the single-process format, from the gathered state: any rank count resumes it.
+        const Simulation whole = dec_->gather(true);
+        if (root_) {
+          CheckpointWriter w;
+          write_run_sections(w, kind, "", whole);
+          w.write_file(path);
+        }
+      } else {
+        CheckpointWriter w;
+        write_run_sections(w, kind, "", sim_);
+        w.write_file(path);
+      }
+    } catch (const InputError& e) {
+      if (dec_) throw RunError(e.what());  // (rank 0's alone: it must end every rank)
+      throw;
     } catch (const std::bad_alloc&) {
       progress_.clear();
       throw OutOfMemory(fmt::format("writing the checkpoint {} ({} balls, {} neighbour rows)", path, sim_.balls.size(),
@@ -603,7 +718,7 @@ class Runner {
     last_checkpoint_stage_ = pos_.stage;
     last_checkpoint_time_ = now_seconds();
     // Keep the newest `keep`.
-    if (seq_ > static_cast<std::uint64_t>(sc_.checkpoints.keep)) {
+    if (root_ && seq_ > static_cast<std::uint64_t>(sc_.checkpoints.keep)) {
       std::error_code ec;
       for (std::uint64_t old = seq_ - static_cast<std::uint64_t>(sc_.checkpoints.keep); old > 0; --old) {
         const fs::path p = fs::path(result_.checkpoint_dir) / fmt::format("ckpt-{:06}.hdc", old);
@@ -615,11 +730,12 @@ class Runner {
   // The state after a blow-up, for inspection (hilldem inspect). Returns a sentence for the error.
   std::string dump_blowup(const std::string& message) {
     if (!opt_.write_files) return "no state file written (file output is off)";
+    if (dec_) return "no state file written (a run over MPI ranks: resume it from its checkpoints)";
     const std::string folder = dir_.empty() ? "." : dir_;
     const std::string path = (fs::path(folder) / fmt::format("blowup-step-{}.hdc", sim_.steps)).string();
     try {
       CheckpointWriter w;
-      write_run_sections(w, "blow-up", message);
+      write_run_sections(w, "blow-up", message, sim_);
       w.write_file(path);
     } catch (const std::exception& e) {
       return std::string("the state could not be written: ") + e.what();
@@ -683,11 +799,13 @@ class Runner {
   void after_cycle(bool stage_ends, double ratio = -1.0) {
     check_blowup();
     if (!stage_ends) {
-      if (snapshots_ && sc_.snapshots.every > 0 && sim_.steps % sc_.snapshots.every == 0) snapshots_->write(sim_);
+      if (!result_.snapshot_dir.empty() && sc_.snapshots.every > 0 && sim_.steps % sc_.snapshots.every == 0)
+        write_snapshot(false);
       const CheckpointSettings& c = sc_.checkpoints;
       if (!result_.checkpoint_dir.empty()) {
         if (c.every > 0 && sim_.steps % c.every == 0) checkpoint("periodic (steps)");
-        else if (c.every_seconds > 0.0 && now_seconds() - last_checkpoint_time_ >= c.every_seconds) checkpoint("periodic (time)");
+        else if (c.every_seconds > 0.0 && agreed(now_seconds() - last_checkpoint_time_ >= c.every_seconds))
+          checkpoint("periodic (time)");
       }
       progress_.tick(sim_, pos_.stage_steps, ratio);
     }
@@ -696,7 +814,7 @@ class Runner {
     if (opt_.stop_requested && opt_.stop_requested()) throw Halted{};
     // (At a stage's last cycle the stop waits for the stage end: a solve resumed at its last step
     // would cycle once more.)
-    if (!stage_ends && stop_requested()) throw Stopped{};
+    if (!stage_ends && stop_signal()) throw Stopped{};
   }
 
   void run_motion(const Stage& s) {
@@ -744,15 +862,15 @@ class Runner {
         while (true) {
           if (pos_.stage_steps >= s.max_steps)
             throw RunError(fmt::format("{}: no equilibrium within max_steps = {} (mean unbalanced-force ratio {:.3g} > {:.3g})",
-                                       stage_head(sc_, pos_.stage), s.max_steps, sim_.mean_unbalanced_ratio(), s.ratio));
+                                       stage_head(sc_, pos_.stage), s.max_steps, unbalanced_ratio(), s.ratio));
           cycle_once();
           ++pos_.stage_steps;
-          const double r = sim_.mean_unbalanced_ratio();
+          const double r = unbalanced_ratio();
           const bool done = r <= s.ratio;
           after_cycle(done, r);
           if (done) break;
         }
-        return fmt::format("equilibrium after {} steps (ratio {:.3g})", pos_.stage_steps, sim_.mean_unbalanced_ratio());
+        return fmt::format("equilibrium after {} steps (ratio {:.3g})", pos_.stage_steps, unbalanced_ratio());
       case StageType::Translate:
       case StageType::Rotate:
         run_motion(s);
@@ -768,10 +886,20 @@ class Runner {
           if (*s.timestep > 0.0) sim_.settings.timestep = *s.timestep;
         }
         return "";
-      case StageType::MakeWet: return fmt::format("{} wet hill contacts", sim_.make_wet(s.wet_suction, s.wet_gap));
-      case StageType::MakeDry: return fmt::format("{} contacts dried", sim_.make_dry());
+      case StageType::MakeWet: {
+        const std::size_t wet = sim_.make_wet(s.wet_suction, s.wet_gap);
+        return fmt::format("{} wet hill contacts", dec_ ? count_contacts(true) : wet);
+      }
+      case StageType::MakeDry: {
+        const std::size_t was_wet = dec_ ? count_contacts(true) : 0;
+        const std::size_t dried = sim_.make_dry();
+        return fmt::format("{} contacts dried", dec_ ? was_wet : dried);
+      }
       case StageType::Probe: {
-        double v = evaluate(sc_, s.quantity, s.servo);
+        // (Over MPI ranks: on the gathered run, by rank 0, which keeps the probes.)
+        const Simulation whole = dec_ ? dec_->gather(false) : Simulation{};
+        if (!root_) return "";
+        double v = evaluate_on(sc_, dec_ ? whole : sim_, s.quantity, s.servo);
         if (!s.ratio_to.empty()) v /= result_.find(s.ratio_to)->value;
         v *= s.scale;
         result_.probes.push_back({s.label, s.quantity.name, s.quantity.target_text,
@@ -779,7 +907,12 @@ class Runner {
         return fmt::format("{} = {:.6g} {}", s.label, v, result_.probes.back().unit);
       }
       case StageType::ListContacts:
-        if (!opt_.quiet) log_ << contact_listing(sim_);
+        if (dec_) {
+          const Simulation whole = dec_->gather(false);
+          if (!opt_.quiet) log_ << contact_listing(whole);
+        } else if (!opt_.quiet) {
+          log_ << contact_listing(sim_);
+        }
         return "";
       case StageType::SetServo: {
         apply_set_servo(sc_, s);
@@ -796,7 +929,7 @@ class Runner {
       const std::size_t n = sc_.stages.size();
       if (pos_.stage >= n) result_.already_complete = true;
       while (pos_.stage < n) {
-        if (stop_requested()) throw Stopped{};
+        if (stop_signal()) throw Stopped{};
         const std::size_t k = pos_.stage;
         const Stage& s = sc_.stages[k];
         ProgressStage ps{k + 1, n, to_string(s.type), s.name, -1, 0.0, 0};
@@ -805,15 +938,17 @@ class Runner {
         progress_.begin_stage(ps, pos_.stage_steps);
         const std::string what = run_stage(s);
         progress_.clear();
+        const std::size_t contacts = count_contacts(false);
         if (!opt_.quiet)
           log_ << fmt::format("{} {}  (step {}, t = {:.6g} s, {} contacts)\n", stage_head(sc_, k), what, sim_.steps,
-                              sim_.time, sim_.contact_count());
+                              sim_.time, contacts);
         pos_ = Position{};
         pos_.stage = k + 1;
         if (changes_state(s.type)) {
-          if (snapshots_ && sc_.snapshots.at_stage_ends) snapshots_->write(sim_, true);
+          if (!result_.snapshot_dir.empty() && sc_.snapshots.at_stage_ends) write_snapshot(true);
           // (Many short stages would otherwise spend their time writing checkpoints.)
-          if (sc_.checkpoints.at_stage_ends && now_seconds() - last_checkpoint_time_ >= sc_.checkpoints.stage_end_min_seconds)
+          if (sc_.checkpoints.at_stage_ends &&
+              agreed(now_seconds() - last_checkpoint_time_ >= sc_.checkpoints.stage_end_min_seconds))
             checkpoint("stage end");
         }
       }
@@ -824,7 +959,7 @@ class Runner {
       result_.halted = true;
     } catch (const Stopped&) {
       progress_.clear();
-      result_.stopped_by = stop_requested();
+      result_.stopped_by = stop_signal();
       checkpoint(fmt::format("stopped by {}", signal_name(result_.stopped_by)).c_str());
       flush_history();
     }
@@ -835,6 +970,8 @@ class Runner {
   Simulation& sim_;
   RunOptions opt_;
   std::ostream& log_;
+  RunDecomposition* dec_;  // (RunOptions::decomposition)
+  bool root_;              // this process writes the files and lines (no decomposition, or rank 0)
   Progress progress_;
   RunResult result_;
   Position pos_;
@@ -990,7 +1127,35 @@ RunResult resume_scenario(const CheckpointReader& r, Scenario& sc, const RunOpti
   return resume_from(r, sc, options, options.output_dir, "", log);
 }
 
+namespace {
+std::string find_resumable(const std::string& path, std::ostream& log);
+}  // namespace
+
 RunResult resume_scenario(const std::string& path, Scenario& sc, const RunOptions& options, std::ostream& log) {
+  // (Over MPI ranks, rank 0 looks at the folder and finds the checkpoint; every rank then reads it.)
+  RunDecomposition* dec = options.decomposition;
+  std::string file, error;
+  if (!dec || dec->rank() == 0) try {
+    file = find_resumable(path, log);
+  } catch (const InputError& e) {
+    if (!dec) throw;
+    error = e.what();
+  }
+  if (dec) {
+    error = dec->from_root(error);
+    if (!error.empty()) throw InputError(error);
+    file = dec->from_root(file);
+  }
+  const CheckpointReader r = CheckpointReader::from_file(file);
+  const fs::path parent = fs::absolute(fs::path(file)).parent_path();
+  const std::string source = (parent.filename() == kCheckpointFolder ? parent.parent_path() : parent).string();
+  const std::string dir = options.output_dir.empty() ? source : options.output_dir;
+  return resume_from(r, sc, options, dir, source, log);
+}
+
+namespace {
+// The checkpoint resume_scenario continues from, after refusing a folder whose run is still going.
+std::string find_resumable(const std::string& path, std::ostream& log) {
   {
     // A folder whose run is still going is refused before anything else is looked at.
     std::error_code ec;
@@ -1003,13 +1168,9 @@ RunResult resume_scenario(const std::string& path, Scenario& sc, const RunOption
       throw InputError(folder.string() + ": the output folder is in use by another hilldem process (" + who +
                        "); resume it when that process has ended");
   }
-  const std::string file = find_checkpoint(path, log);
-  const CheckpointReader r = CheckpointReader::from_file(file);
-  const fs::path parent = fs::absolute(fs::path(file)).parent_path();
-  const std::string source = (parent.filename() == kCheckpointFolder ? parent.parent_path() : parent).string();
-  const std::string dir = options.output_dir.empty() ? source : options.output_dir;
-  return resume_from(r, sc, options, dir, source, log);
+  return find_checkpoint(path, log);
 }
+}  // namespace
 
 std::string describe_checkpoint(const std::string& path, std::optional<std::int64_t> ball) {
   return describe_checkpoint(CheckpointReader::from_file(path), ball);

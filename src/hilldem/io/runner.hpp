@@ -32,6 +32,32 @@ struct ProbeValue {
   double value = 0.0;
 };
 
+// A run decomposed over MPI ranks (parallel/run_mpi.hpp, docs/mpi.md): every rank runs the same
+// stages on its part of the run (its Simulation's balls are its own and its ghosts), and whatever
+// the runner reads of the whole run, or must decide as one, it gets here. Rank 0 writes every file
+// (histories, probes, snapshots, checkpoints: from the gathered whole run) and every line. Every call
+// is collective (every rank makes it, in the same order), except rank(), size() and owns().
+class RunDecomposition {
+ public:
+  virtual ~RunDecomposition() = default;
+  // Make sim, the whole run (the same on every rank), this rank's part. reach [m]: the largest
+  // distance between two balls' surfaces a stage asks for (make_wet's gap), so the ghosts cover it.
+  virtual void attach(Simulation& sim, double reach) = 0;
+  virtual int rank() const = 0;
+  virtual int size() const = 0;
+  // Whether this rank owns local ball i (after attach).
+  virtual bool owns(std::size_t local) const = 0;
+  // The whole run on rank 0 (with its cycle state when with_cycle: checkpoints); empty elsewhere.
+  virtual Simulation gather(bool with_cycle) = 0;
+  // Rank 0's value on every rank.
+  virtual std::int64_t from_root(std::int64_t v) = 0;
+  virtual double from_root(double v) = 0;
+  virtual std::string from_root(const std::string& s) = 0;
+  // The largest over the ranks, and the sum (integers: exact in any order).
+  virtual std::int64_t max(std::int64_t v) = 0;
+  virtual std::uint64_t sum(std::uint64_t v) = 0;
+};
+
 struct RunOptions {
   bool quiet = false;             // no stage lines, listings or progress
   std::string output_dir;         // overrides the scenario's [output] dir when not empty
@@ -46,6 +72,10 @@ struct RunOptions {
   // with it): when it returns true the run ends at that cycle boundary as at halt_after_step
   // (RunResult::halted; no stage-end outputs). Empty: never asked.
   std::function<bool()> stop_requested;
+  // The run over MPI ranks this process is one rank of (null: the whole run here). Over more than
+  // one rank, stages that impose a ball's motion or position (translate, rotate, set on balls) are
+  // refused (InputError).
+  RunDecomposition* decomposition = nullptr;
 };
 
 struct RunResult {

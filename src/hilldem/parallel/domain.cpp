@@ -9,6 +9,7 @@
 #include <string>
 #include <type_traits>
 
+#include "hilldem/core/error.hpp"
 #include "hilldem/engine/force_pass.hpp"
 
 namespace hilldem::parallel {
@@ -144,9 +145,14 @@ ContactStore sort_rows(ContactStore& rows, const std::vector<std::uint32_t>* glo
 
 }  // namespace
 
-Domain::Domain(MPI_Comm comm, Simulation& sim) : comm_(comm), sim_(&sim) {
+Domain::Domain(MPI_Comm comm, Simulation& sim, double min_reach) : comm_(comm), min_reach_(min_reach), sim_(&sim) {
   MPI_Comm_rank(comm_, &rank_);
   MPI_Comm_size(comm_, &size_);
+  if (size_ > 1 && !sim.clumps.empty())
+    throw InputError("clumps are not decomposed over MPI ranks yet (docs/mpi.md): run on one rank");
+  // The cycle state of a run that has cycled (a restored checkpoint), kept below.
+  CycleState cycled = sim.cycle_state();
+  const bool keep_cycle = !cycled.rebuild_needed && cycled.position_at_build.size() == sim.balls.size();
   // The skin from the radii (settings.skin 0) would be each rank's own mean: the whole run's instead.
   skin_given_ = sim.settings.skin;
   if (sim.settings.skin <= 0.0) sim.settings.skin = sim.skin();
@@ -195,7 +201,17 @@ Domain::Domain(MPI_Comm comm, Simulation& sim) : comm_(comm), sim_(&sim) {
   sim.contacts = sort_rows(rows, &global_);
   sim.balls = std::move(balls);
   make_lists(sim);
-  sim.domain = this;  // (the list no longer fits the balls: the next force pass detects afresh)
+  sim.domain = this;  // (unless kept below, the list no longer fits the balls: the next force pass detects afresh)
+  if (keep_cycle) {
+    // The rows here are every row of the owned balls (all of a ball's rows were between balls within
+    // the ghost width), so the local list is complete for them, and the next rebuild comes when some
+    // ball, on some rank, has travelled half the skin since the whole run's last one.
+    std::vector<Vec3> at(global_.size());
+    for (std::size_t i = 0; i < global_.size(); ++i) at[i] = cycled.position_at_build[global_[i]];
+    cycled.position_at_build = std::move(at);
+    cycled.rows_complete = true;
+    sim.restore_cycle_state(std::move(cycled));
+  }
 }
 
 Domain::~Domain() = default;
@@ -205,10 +221,18 @@ std::size_t Domain::owned() const {
 }
 
 void Domain::set_width(const Simulation& sim) {
-  double r = 0.0;
-  for (double x : sim.balls.radius) r = std::max(r, x);
-  MPI_Allreduce(MPI_IN_PLACE, &r, 1, MPI_DOUBLE, MPI_MAX, comm_);
-  width_ = sim.settings.proximity + sim.skin() + 2.0 * r;
+  // The largest radius, and the largest gap [m] of an existing ball-ball row: wet contacts outlive
+  // the reach (the rebuild's merge keeps them, spec §2.7), and the owner of a row's first ball must
+  // hold its second to go on computing it.
+  double r[2] = {0.0, std::max(sim.settings.proximity, min_reach_)};
+  for (double x : sim.balls.radius) r[0] = std::max(r[0], x);
+  for (std::size_t c = 0; c < sim.contacts.size(); ++c)
+    if (sim.contacts.exists[c] && sim.contacts.key[c].kind == ContactKind::BallBall) {
+      const ContactGeometry g = sim.geometry(c);
+      if (g.valid) r[1] = std::max(r[1], g.gap);
+    }
+  MPI_Allreduce(MPI_IN_PLACE, r, 2, MPI_DOUBLE, MPI_MAX, comm_);
+  width_ = r[1] + sim.skin() + 2.0 * r[0];
 }
 
 void Domain::ranks_of(const Vec3& x, std::vector<int>& out) const {
@@ -373,16 +397,61 @@ void Domain::before_rebuild(Simulation& sim) {
   ++bytes_.rebuilds;
 }
 
-Simulation Domain::gather() const {
+void Domain::after_forces(Simulation& sim) {
+  if (sim.walls.walls.empty()) return;
+  // One active wall row of an owned ball: its key in global indices and its share (72 bytes).
+  struct Share {
+    std::uint32_t ball, wall;
+    WallShare share;
+  };
+  static_assert(std::is_trivially_copyable_v<Share>);
+  std::vector<Share> mine;
+  const ContactStore& rows = sim.contacts;
+  for (std::size_t c = 0; c < rows.size(); ++c) {
+    const ContactKey& k = rows.key[c];
+    if (k.kind != ContactKind::BallWall || !rows.active[c] || owner_[k.a] != rank_) continue;
+    mine.push_back({global_[k.a], k.b,
+                    wall_row_share(sim.walls.walls[k.b], rows, c, sim.balls.position[k.a], sim.balls.radius[k.a])});
+  }
+  const int bytes = static_cast<int>(mine.size() * sizeof(Share));
+  std::vector<int> counts(static_cast<std::size_t>(size_)), at(static_cast<std::size_t>(size_) + 1, 0);
+  MPI_Allgather(&bytes, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
+  for (int q = 0; q < size_; ++q) at[q + 1] = at[q] + counts[q];
+  wall_in_.resize(static_cast<std::size_t>(at[size_]));
+  MPI_Allgatherv(mine.data(), bytes, MPI_BYTE, wall_in_.data(), counts.data(), at.data(), MPI_BYTE, comm_);
+  bytes_.walls += static_cast<std::uint64_t>(bytes) * static_cast<std::uint64_t>(size_ - 1);
+  std::vector<Share> all(wall_in_.size() / sizeof(Share));
+  std::memcpy(all.data(), wall_in_.data(), wall_in_.size());
+  // The whole run's row order (ContactKey: kind, then ball, then wall), from zero.
+  std::sort(all.begin(), all.end(), [](const Share& x, const Share& y) { return x.ball != y.ball ? x.ball < y.ball : x.wall < y.wall; });
+  for (Wall& w : sim.walls.walls) clear_wall_sums(w);
+  for (const Share& s : all) add_wall_share(sim.walls.walls[s.wall], s.share);
+}
+
+double Domain::min_over_ranks(double x) {
+  // A ghost's stiffness sums are over part of its rows, each term ≥ 0, so never above its owner's
+  // (rounding is monotonic): its m/k is never below, and the minimum over the ranks is that over
+  // the owned balls, the whole run's.
+  MPI_Allreduce(MPI_IN_PLACE, &x, 1, MPI_DOUBLE, MPI_MIN, comm_);
+  return x;
+}
+
+Simulation Domain::gather(bool with_cycle) const {
   const Simulation& sim = *sim_;
+  const CycleState cycle = with_cycle ? sim.cycle_state() : CycleState{};
+  const bool built = with_cycle && cycle.position_at_build.size() == global_.size();
   Buffer b;
+  b.put(static_cast<std::uint8_t>(built));
   auto& balls = const_cast<BallStore&>(sim.balls);  // (for_each_column is non-const; only read)
   auto& rows = const_cast<ContactStore&>(sim.contacts);
   std::uint32_t n_owned = 0;
   for (std::size_t i = 0; i < global_.size(); ++i) n_owned += owner_[i] == rank_;
   b.put(n_owned);
   for (std::size_t i = 0; i < global_.size(); ++i)
-    if (owner_[i] == rank_) put_ball(b, balls, i, global_[i], rank_);
+    if (owner_[i] == rank_) {
+      put_ball(b, balls, i, global_[i], rank_);
+      if (built) b.put(cycle.position_at_build[i]);
+    }
   for (std::size_t c = 0; c < rows.size(); ++c) {
     ContactKey g = rows.key[c];
     if (owner_[g.a] != rank_) continue;
@@ -409,12 +478,20 @@ Simulation Domain::gather() const {
   std::vector<std::uint32_t> global;
   std::vector<int> owner;
   ContactStore arrived;
+  bool all_built = with_cycle;
+  std::vector<Vec3> at_build;  // (in arrival order, as the balls)
   for (int q = 0; q < size_; ++q) {
     Reader in{all.data() + at[q], all.data() + at[q + 1]};
+    const bool built_there = in.get<std::uint8_t>() != 0;
+    all_built = all_built && built_there;
     const auto balls_here = in.get<std::uint32_t>();
-    for (std::uint32_t k = 0; k < balls_here; ++k) get_ball(in, whole.balls, global, owner);
+    for (std::uint32_t k = 0; k < balls_here; ++k) {
+      get_ball(in, whole.balls, global, owner);
+      if (built_there) at_build.push_back(in.get<Vec3>());
+    }
     while (in.p < in.end) get_row(in, arrived);
   }
+  std::vector<std::uint32_t> arrival = global;  // (global indices in arrival order)
   sort_balls(whole.balls, global, owner);
   for (std::size_t k = 0; k < global.size(); ++k)
     if (global[k] != k) throw std::runtime_error("domain gather: ball " + std::to_string(k) + " is missing");
@@ -425,6 +502,21 @@ Simulation Domain::gather() const {
     const ContactKey& k = whole.contacts.key[c];
     if (k.kind != ContactKind::BallWall || !whole.contacts.active[c]) continue;
     add_wall_row(whole.walls.walls[k.b], whole.contacts, c, whole.balls.position[k.a], whole.balls.radius[k.a]);
+  }
+  if (with_cycle) {
+    // The rows here are every row of every ball (each from its first ball's owner, who holds them
+    // all): the whole neighbour list. The counters are every rank's (all rebuild together); the
+    // count of pairs no rule matched, information only, is rank 0's.
+    CycleState whole_cycle = cycle;
+    whole_cycle.position_at_build.clear();
+    if (all_built) {
+      whole_cycle.position_at_build.resize(at_build.size());
+      for (std::size_t k = 0; k < arrival.size(); ++k) whole_cycle.position_at_build[arrival[k]] = at_build[k];
+    } else {
+      whole_cycle.rebuild_needed = true;
+    }
+    whole_cycle.rows_complete = true;
+    whole.restore_cycle_state(std::move(whole_cycle));
   }
   return whole;
 }

@@ -10,7 +10,8 @@
 //
 // Per step (DomainHooks): after the law of motion each owner sends its balls' position, velocity and
 // spin to the ranks that ghost them (after_motion); the rebuild decision is the OR of the ranks'
-// (rebuild_anywhere); before a rebuild (before_rebuild) the balls go to their new owner and ghost
+// (rebuild_anywhere); after the force pass the walls' sums are made from every rank's owned rows in
+// the whole run's row order (after_forces); before a rebuild (before_rebuild) the balls go to their new owner and ghost
 // ranks with every column, and each row goes from the owner of its first ball to every rank that
 // will hold both its balls, with its history (the pattern of LAMMPS's fix neigh/history). The
 // sub-domains are cut again by Zoltan RCB, weighted by rows per ball, when the rows per rank are out
@@ -32,6 +33,7 @@ namespace hilldem::parallel {
 struct ExchangeBytes {
   std::uint64_t ghost = 0;      // after_motion: ghosts' motion
   std::uint64_t migration = 0;  // before_rebuild: balls and rows
+  std::uint64_t walls = 0;      // after_forces: the walls' shares of owned rows
   std::int64_t steps = 0, rebuilds = 0, repartitions = 0;
 };
 
@@ -41,9 +43,13 @@ class Domain final : public DomainHooks {
   static constexpr double kImbalance = 1.10;
 
   // Make `sim`, the whole run (the same on every rank: balls, walls, rows), this rank's part, and
-  // attach to it (sim.domain). sim must stay where it is while attached; a Simulation that outlives
+  // attach to it (sim.domain). A run that has cycled (its neighbour list built: a restored
+  // checkpoint) keeps its cycle state, each rank the positions at the last rebuild of its balls, so
+  // that it rebuilds when the whole run would. Throws InputError for clumps over more than one rank. sim must stay where it is while attached; a Simulation that outlives
   // its Domain is detached by setting sim.domain = nullptr (the destructor does not touch sim).
-  Domain(MPI_Comm comm, Simulation& sim);
+  // min_reach [m]: the ghosts cover pairs this far apart beyond their radii (make_wet's gap), as they
+  // do the normal reach (proximity) and every existing row's gap.
+  Domain(MPI_Comm comm, Simulation& sim, double min_reach = 0.0);
   ~Domain() override;
   Domain(const Domain&) = delete;
   Domain& operator=(const Domain&) = delete;
@@ -51,10 +57,16 @@ class Domain final : public DomainHooks {
   void after_motion(Simulation& sim) override;
   bool rebuild_anywhere(bool here) override;
   void before_rebuild(Simulation& sim) override;
+  // Every active wall row of an owned ball gives its share (wall_row_share) to every rank; each rank
+  // adds them all, by key (global ball index, wall), from zero: the whole run's sums, bitwise.
+  void after_forces(Simulation& sim) override;
+  double min_over_ranks(double x) override;
 
   // The whole run's state on rank 0 (balls by global index, rows by key in global indices, the walls'
-  // sums over all rows in row order); an empty Simulation on other ranks. Collective.
-  Simulation gather() const;
+  // sums over all rows in row order); an empty Simulation on other ranks. Collective. with_cycle:
+  // with the whole run's cycle state too (the positions at the last rebuild from the balls' owners),
+  // so that a checkpoint of it resumes with the next rebuild where the whole run makes it.
+  Simulation gather(bool with_cycle = false) const;
 
   int rank() const { return rank_; }
   int size() const { return size_; }
@@ -63,7 +75,8 @@ class Domain final : public DomainHooks {
   // The global index of local ball i.
   std::uint32_t global_index(std::size_t local) const { return global_[local]; }
   std::size_t ghosts() const { return global_.size() - owned(); }
-  // The ghost layer's width [m]: reach (proximity + skin) + twice the largest radius.
+  // The ghost layer's width [m]: the reach (the largest of proximity, min_reach and every existing
+  // row's gap, + skin) + twice the largest radius.
   double ghost_width() const { return width_; }
   const ExchangeBytes& bytes() const { return bytes_; }
 
@@ -71,6 +84,7 @@ class Domain final : public DomainHooks {
   MPI_Comm comm_;
   int rank_ = 0, size_ = 1;
   Simulation* sim_;
+  double min_reach_ = 0.0;           // [m]
   double skin_given_ = 0.0;          // the scenario's skin (0: from the radii, fixed at the attach)
   std::unique_ptr<RcbPartition> rcb_;
   double width_ = 0.0;               // [m]
@@ -79,6 +93,7 @@ class Domain final : public DomainHooks {
   // after_motion's lists: per rank, the local balls sent (owned here, ghosted there) and received.
   std::vector<std::vector<std::uint32_t>> send_, recv_;
   ExchangeBytes bytes_;
+  std::vector<char> wall_in_;  // after_forces: every rank's shares
 
   void set_width(const Simulation& sim);
   void cut(const Simulation& sim, bool weighted);
