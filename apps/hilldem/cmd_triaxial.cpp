@@ -226,8 +226,8 @@ Command add_triaxial_command(CLI::App& app) {
                   "specimen is first brought to it on every wall; a comma list (50e3,100e3,150e3) runs every case at each")
       ->delimiter(',');
   cmd->add_flag("--pack-linear", o->pack_linear,
-                "pack every material with frictionless linear contacts, one packing per grading (the former shared "
-                "packing; a deviation from the memo, which packs each material with its own model)");
+                "pack every material with frictionless linear contacts, one packing per grading shared "
+                "by both materials (a deviation from the memo, which packs each material with its own model)");
   cmd->add_option("--cycles", o->cycles, "axial strains [%] at which load-unload cycles reverse, increasing (default 0.02,0.05)")
       ->delimiter(',')->check(finite_number());
   cmd->add_option("--final-strain", o->final_strain, "final axial strain [%] (default 1)")->check(finite_number());

@@ -23,20 +23,8 @@ namespace hilldem {
 void Simulation::cycle(std::int64_t n) { cycle(n, {}); }
 
 std::int64_t Simulation::cycle(std::int64_t n, const std::function<bool()>& stop) {
-  drop_records();  // the caller may have changed the columns since the last call
-  for (std::int64_t k = 0; k < n; ++k) {
-    const bool interrupted = interrupt && interrupt();
-    const bool last = k + 1 == n || interrupted || (stop && stop());
-    steps_ahead_ = last ? 0 : n - 1 - k;  // (whether the live records pay: force_pass)
-    step_once(last);
-    if (interrupted) throw_interrupted();
-    if (last) {
-      steps_ahead_ = 0;
-      return k + 1;
-    }
-  }
-  steps_ahead_ = 0;
-  return n;
+  // drive() with a plan that sets nothing: stop() asked before each cycle's law of motion.
+  return drive(n, [&stop](double) { return stop && stop(); });
 }
 
 std::int64_t Simulation::drive(std::int64_t n, const std::function<bool(double)>& plan) {
