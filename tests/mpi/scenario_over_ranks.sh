@@ -4,10 +4,11 @@
 #                                                             (the one after make_wet included), the
 #                                                             history, the probes and the snapshots
 #                                                             (files) are one process's
-#   scenario_over_ranks.sh HILLDEM WORKDIR SCENARIO resume    a checkpoint of 4 ranks (mid-stage, and the
-#                                                             one after make_wet) resumed on 2 ranks, 1
-#                                                             rank and without mpirun, and one of one
-#                                                             process resumed on 3 ranks: the
+#   scenario_over_ranks.sh HILLDEM WORKDIR SCENARIO resume [K...]
+#                                                             checkpoints K of 4 ranks (default 000005
+#                                                             and 000009) resumed on 2 ranks, 1 rank and
+#                                                             without mpirun, and the one-process run's
+#                                                             last of them resumed on 3 ranks: the
 #                                                             uninterrupted run's final digest and history
 # MPIRUN (environment): the launcher command line, e.g. "mpiexec --allow-run-as-root --oversubscribe".
 set -u
@@ -19,7 +20,7 @@ digests() {  # every checkpoint of run folder $1: "NAME DIGEST" lines
     echo "$(basename "$f") $("$hilldem" inspect "$f" | grep -o 'state digest: [0-9a-f]*')"
   done
 }
-probes() { grep -E '^(lid_stress|floor_fz) ' "$1"; }
+probes() { grep -E '^(lid_stress|floor_fz|plough_fx) ' "$1"; }
 same() {  # what, expected file, actual file
   if ! cmp -s "$2" "$3"; then
     echo "FAIL: $1 differ:"; diff "$2" "$3" | head -20; fail=1
@@ -48,7 +49,10 @@ case $mode in
   resume)
     $MPIRUN -np 4 "$hilldem" run "$scenario" -q -o "$work/four" > /dev/null || { echo "FAIL: the run on 4 ranks"; exit 1; }
     final=$(tail -1 "$work/one.digests" | cut -d' ' -f2-)
-    for k in 000005 000009; do
+    shift 4
+    ckpts=("$@")
+    [ $# -eq 0 ] && ckpts=(000005 000009)
+    for k in "${ckpts[@]}"; do
       ckpt="$work/four/checkpoints/ckpt-$k.hdc"
       echo "from $(basename "$ckpt"): $("$hilldem" inspect "$ckpt" | grep -E '^(clock|position)' | tr '\n' ' ')"
       for how in 2 1 plain; do
@@ -65,7 +69,7 @@ case $mode in
     done
     # And the one-process run's checkpoint resumed on 3 ranks.
     out="$work/resumed-one-3"
-    $MPIRUN -np 3 "$hilldem" resume "$work/one/checkpoints/ckpt-000009.hdc" -q -o "$out" > "$out.out" || { echo "FAIL: resume on 3"; fail=1; }
+    $MPIRUN -np 3 "$hilldem" resume "$work/one/checkpoints/ckpt-${ckpts[-1]}.hdc" -q -o "$out" > "$out.out" || { echo "FAIL: resume on 3"; fail=1; }
     got=$(tail -1 <(digests "$out") | cut -d' ' -f2-)
     if [ "$got" != "$final" ]; then echo "FAIL: one process's checkpoint resumed on 3 ranks: $got, uninterrupted: $final"; fail=1
     else echo "ok: one process's checkpoint resumed on 3 ranks: $got"; fi

@@ -27,7 +27,13 @@ foreach(ranks 1 2 3 4)
   add_test(NAME mpi.triaxial_servos_run_${ranks}_ranks
     COMMAND ${HILLDEM_MPI_SCENARIO} ${CMAKE_CURRENT_BINARY_DIR}/mpi_triaxial_${ranks}
             ${CMAKE_CURRENT_SOURCE_DIR}/mpi/triaxial_servos.toml run ${ranks})
-  list(APPEND HILLDEM_MPI_SCENARIO_TESTS mpi.wet_servo_run_${ranks}_ranks mpi.triaxial_servos_run_${ranks}_ranks)
+  # Stages that impose balls' motion and position (translate, rotate, set): a plough ball dragged
+  # across the sub-domains' cuts.
+  add_test(NAME mpi.moving_balls_run_${ranks}_ranks
+    COMMAND ${HILLDEM_MPI_SCENARIO} ${CMAKE_CURRENT_BINARY_DIR}/mpi_moving_balls_${ranks}
+            ${CMAKE_CURRENT_SOURCE_DIR}/mpi/moving_balls.toml run ${ranks})
+  list(APPEND HILLDEM_MPI_SCENARIO_TESTS mpi.wet_servo_run_${ranks}_ranks mpi.triaxial_servos_run_${ranks}_ranks
+       mpi.moving_balls_run_${ranks}_ranks)
 endforeach()
 # examples/assembly_27.toml (hill grains in a box of facets, the automatic time step, solve) on 2 and 4.
 foreach(ranks 2 4)
@@ -41,16 +47,16 @@ endforeach()
 add_test(NAME mpi.checkpoint_of_4_ranks_resumes_on_2_and_1
   COMMAND ${HILLDEM_MPI_SCENARIO} ${CMAKE_CURRENT_BINARY_DIR}/mpi_wet_servo_resume
           ${CMAKE_CURRENT_SOURCE_DIR}/mpi/wet_servo_box.toml resume)
-list(APPEND HILLDEM_MPI_SCENARIO_TESTS mpi.checkpoint_of_4_ranks_resumes_on_2_and_1)
+# The moving balls' checkpoints from 4 ranks in the middle of the translate and of the rotate stage
+# (the fixities to restore at the stage's end saved in them) resumed likewise.
+add_test(NAME mpi.moving_balls_checkpoint_of_4_ranks_resumes_on_2_and_1
+  COMMAND ${HILLDEM_MPI_SCENARIO} ${CMAKE_CURRENT_BINARY_DIR}/mpi_moving_balls_resume
+          ${CMAKE_CURRENT_SOURCE_DIR}/mpi/moving_balls.toml resume 000005 000009)
+list(APPEND HILLDEM_MPI_SCENARIO_TESTS mpi.checkpoint_of_4_ranks_resumes_on_2_and_1
+     mpi.moving_balls_checkpoint_of_4_ranks_resumes_on_2_and_1)
 string(REPLACE ";" " " HILLDEM_MPIRUN_LINE "${HILLDEM_MPIRUN}")
 set_tests_properties(${HILLDEM_MPI_SCENARIO_TESTS} PROPERTIES TIMEOUT 300 LABELS mpi
   ENVIRONMENT "OMP_NUM_THREADS=1;MPIRUN=${HILLDEM_MPIRUN_LINE}")
-# A stage that imposes balls' motion does not run decomposed yet: said once (rank 0), exit status 2.
-add_test(NAME mpi.translate_over_ranks_exits_2
-  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "sets balls' motion or position does not run decomposed"
-          2 ${HILLDEM_MPIRUN} -np 2 $<TARGET_FILE:hilldem> run -q ${PROJECT_SOURCE_DIR}/examples/two_grains_shear_dashpot.toml
-          -o ${CMAKE_CURRENT_BINARY_DIR}/mpi_translate)
-set_tests_properties(mpi.translate_over_ranks_exits_2 PROPERTIES TIMEOUT 120 LABELS mpi)
 # Commands that do not run decomposed yet say so once, with exit status 2.
 add_test(NAME mpi.run_on_two_ranks_exits_2
   COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "does not run decomposed"

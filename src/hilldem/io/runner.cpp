@@ -219,24 +219,26 @@ std::uint32_t check_history_prefix(const std::string& path, std::uint64_t bytes,
   return sum;
 }
 
-void apply_set(Simulation& sim, const Stage& s) {
+// `balls`: the local indices of the stage's selection that this Simulation holds (all of it, but
+// one rank's part over MPI ranks: the owners' copies and the ghosts', which must agree).
+void apply_set(Simulation& sim, const Stage& s, const std::vector<std::size_t>& balls) {
   for (std::size_t k : s.sel.walls) {
     Wall& w = sim.walls.walls[k];
     if (s.velocity) w.velocity = *s.velocity;
     if (s.spin) w.spin = *s.spin;
     if (s.radial_velocity) w.radial_velocity = *s.radial_velocity;
   }
-  for (std::size_t i : s.sel.balls) {
+  for (std::size_t i : balls) {
     BallStore& b = sim.balls;
     if (s.velocity) b.velocity[i] = *s.velocity;
     if (s.spin) b.spin[i] = *s.spin;
     if (s.applied_force) b.applied_force[i] = *s.applied_force;
     b.fixity[i] = static_cast<FixityMask>((b.fixity[i] | s.fix) & ~s.free);
-    if (s.position) {
-      b.position[i] = *s.position;
-      sim.invalidate_forces();
-    }
+    if (s.position) b.position[i] = *s.position;
   }
+  // On the selection, not on what is held here: over MPI ranks every rank rebuilds (its balls go to
+  // the ranks their new positions call for), whether it holds a moved ball or not.
+  if (s.position && !s.sel.balls.empty()) sim.invalidate_forces();
 }
 
 void apply_set_contacts(Simulation& sim, const Stage& s) {
@@ -417,24 +419,44 @@ class Runner {
  private:
   // ---- over MPI ranks ----
 
-  // This rank's part of the run (RunOptions::decomposition), after refusing what does not run
-  // decomposed. The ghosts cover the widest make_wet gap of the scenario.
+  // This rank's part of the run (RunOptions::decomposition). The ghosts cover the widest make_wet gap
+  // of the scenario.
   void decompose() {
     if (!dec_) return;
-    if (dec_->size() > 1)
-      for (std::size_t k = 0; k < sc_.stages.size(); ++k) {
-        const Stage& s = sc_.stages[k];
-        const bool moves_balls = s.type == StageType::Translate || s.type == StageType::Rotate ||
-                                 (s.type == StageType::Set && !s.sel.balls.empty());
-        if (moves_balls)
-          throw InputError(fmt::format("{}: a stage that sets balls' motion or position does not run decomposed over "
-                                       "MPI ranks yet (docs/mpi.md): run it on one rank",
-                                       stage_head(sc_, k)));
-      }
     double reach = 0.0;  // [m]
     for (const Stage& s : sc_.stages)
       if (s.type == StageType::MakeWet) reach = std::max(reach, s.wet_gap);
     dec_->attach(sim_, reach);
+  }
+
+  // The balls of a selection (the whole run's indices) that this rank holds, as (place in the
+  // selection, local index), in selection order. Over MPI ranks the set changes at each rebuild (the
+  // balls migrate), so a stage asks again before every cycle.
+  std::vector<std::pair<std::size_t, std::size_t>> held(const std::vector<std::size_t>& sel) const {
+    std::vector<std::pair<std::size_t, std::size_t>> out;
+    out.reserve(sel.size());
+    for (std::size_t n = 0; n < sel.size(); ++n) {
+      const std::int64_t i = dec_ ? dec_->local_of(sel[n]) : static_cast<std::int64_t>(sel[n]);
+      if (i >= 0) out.emplace_back(n, static_cast<std::size_t>(i));
+    }
+    return out;
+  }
+
+  // The fixities of a selection's balls in the whole run, in selection order (over MPI ranks: rank
+  // 0's from the gathered run, on every rank).
+  std::vector<FixityMask> selected_fixity(const std::vector<std::size_t>& sel) {
+    std::vector<FixityMask> f;
+    if (!dec_) {
+      for (std::size_t i : sel) f.push_back(sim_.balls.fixity[i]);
+      return f;
+    }
+    const Simulation whole = dec_->gather(false);
+    std::string bytes;
+    if (root_)
+      for (std::size_t i : sel) bytes.push_back(static_cast<char>(whole.balls.fixity[i]));
+    bytes = dec_->from_root(bytes);
+    for (char c : bytes) f.push_back(static_cast<FixityMask>(static_cast<unsigned char>(c)));
+    return f;
   }
 
   // Whether rank 0's answer is yes (decisions on the clock must be the same on every rank).
@@ -821,28 +843,25 @@ class Runner {
     const bool spin = s.type == StageType::Rotate;
     const FixityMask mask = spin ? kFixSpin : kFixVel;
     if (!pos_.started) {
-      pos_.saved_fixity.clear();
-      for (std::size_t i : s.sel.balls) {
-        pos_.saved_fixity.push_back(sim_.balls.fixity[i]);
-        sim_.balls.fixity[i] |= mask;
-      }
+      pos_.saved_fixity = selected_fixity(s.sel.balls);
+      for (const auto& [n, i] : held(s.sel.balls)) sim_.balls.fixity[i] |= mask;
       pos_.motion_done = Vec3{};
       pos_.started = true;
     }
     // Imposed velocities, so that the contacts see the motion step by step; the rate is re-aimed at
-    // what is left each step (the time step may change).
+    // what is left each step (the time step may change). Set on every copy held here (over MPI ranks
+    // the ghosts' too, so that a ghost stays an exact copy of its owner's ball).
     while (pos_.stage_steps < s.steps) {
       const double dt = sim_.next_timestep();
       const Vec3 rate = (s.by - pos_.motion_done) / (static_cast<double>(s.steps - pos_.stage_steps) * dt);
-      for (std::size_t i : s.sel.balls) (spin ? sim_.balls.spin[i] : sim_.balls.velocity[i]) = rate;
+      for (const auto& [n, i] : held(s.sel.balls)) (spin ? sim_.balls.spin[i] : sim_.balls.velocity[i]) = rate;
       cycle_once();
       pos_.motion_done += rate * sim_.last_dt;
       ++pos_.stage_steps;
       after_cycle(pos_.stage_steps == s.steps);
     }
     // Left at rest with their former fixity.
-    for (std::size_t n = 0; n < s.sel.balls.size(); ++n) {
-      const std::size_t i = s.sel.balls[n];
+    for (const auto& [n, i] : held(s.sel.balls)) {
       (spin ? sim_.balls.spin[i] : sim_.balls.velocity[i]) = Vec3{};
       sim_.balls.fixity[i] = pos_.saved_fixity[n];
     }
@@ -876,7 +895,12 @@ class Runner {
         run_motion(s);
         return fmt::format("{} by [{:g}, {:g}, {:g}] {} in {} steps", s.sel.text, s.by.x, s.by.y, s.by.z,
                            s.type == StageType::Rotate ? "rad" : "m", s.steps);
-      case StageType::Set: apply_set(sim_, s); return s.sel.text;
+      case StageType::Set: {
+        std::vector<std::size_t> balls;
+        for (const auto& [n, i] : held(s.sel.balls)) balls.push_back(i);
+        apply_set(sim_, s, balls);
+        return s.sel.text;
+      }
       case StageType::SetContacts: apply_set_contacts(sim_, s); return "";
       case StageType::SetSimulation:
         if (s.gravity) sim_.settings.gravity = *s.gravity;

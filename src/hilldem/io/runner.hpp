@@ -47,6 +47,9 @@ class RunDecomposition {
   virtual int size() const = 0;
   // Whether this rank owns local ball i (after attach).
   virtual bool owns(std::size_t local) const = 0;
+  // The local index of the whole run's ball `global` (a stage's selection is of the whole run's
+  // indices) where this rank holds it, owned or as a ghost; -1 where it does not (after attach).
+  virtual std::int64_t local_of(std::size_t global) const = 0;
   // The whole run on rank 0 (with its cycle state when with_cycle: checkpoints); empty elsewhere.
   virtual Simulation gather(bool with_cycle) = 0;
   // Rank 0's value on every rank.
@@ -72,9 +75,7 @@ struct RunOptions {
   // with it): when it returns true the run ends at that cycle boundary as at halt_after_step
   // (RunResult::halted; no stage-end outputs). Empty: never asked.
   std::function<bool()> stop_requested;
-  // The run over MPI ranks this process is one rank of (null: the whole run here). Over more than
-  // one rank, stages that impose a ball's motion or position (translate, rotate, set on balls) are
-  // refused (InputError).
+  // The run over MPI ranks this process is one rank of (null: the whole run here).
   RunDecomposition* decomposition = nullptr;
 };
 

@@ -220,6 +220,11 @@ std::size_t Domain::owned() const {
   return static_cast<std::size_t>(std::count(owner_.begin(), owner_.end(), rank_));
 }
 
+std::int64_t Domain::local_of(std::uint32_t global) const {
+  const auto it = std::lower_bound(global_.begin(), global_.end(), global);
+  return it != global_.end() && *it == global ? it - global_.begin() : -1;
+}
+
 void Domain::set_width(const Simulation& sim) {
   // The largest radius, and the largest gap [m] of an existing ball-ball row: wet contacts outlive
   // the reach (the rebuild's merge keeps them, spec §2.7), and the owner of a row's first ball must

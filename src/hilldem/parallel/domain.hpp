@@ -74,6 +74,9 @@ class Domain final : public DomainHooks {
   bool owns(std::size_t local) const { return owner_[local] == rank_; }
   // The global index of local ball i.
   std::uint32_t global_index(std::size_t local) const { return global_[local]; }
+  // The local index of the whole run's ball `global`, owned or ghost, or -1 where this rank does not
+  // hold it (a binary search: local order is global order).
+  std::int64_t local_of(std::uint32_t global) const;
   std::size_t ghosts() const { return global_.size() - owned(); }
   // The ghost layer's width [m]: the reach (the largest of proximity, min_reach and every existing
   // row's gap, + skin) + twice the largest radius.

@@ -21,6 +21,9 @@ class RunOverRanks final : public RunDecomposition {
   int rank() const override { return rank_; }
   int size() const override { return size_; }
   bool owns(std::size_t local) const override { return domain_->owns(local); }
+  std::int64_t local_of(std::size_t global) const override {
+    return global > UINT32_MAX ? -1 : domain_->local_of(static_cast<std::uint32_t>(global));
+  }
   Simulation gather(bool with_cycle) override { return domain_->gather(with_cycle); }
   std::int64_t from_root(std::int64_t v) override;
   double from_root(double v) override;
