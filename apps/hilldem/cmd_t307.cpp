@@ -15,6 +15,8 @@
 #include "commands.hpp"
 #include "hilldem/core/error.hpp"
 #include "hilldem/io/output_folder.hpp"
+#include "hilldem/io/runner.hpp"
+#include "hilldem/io/stop_signal.hpp"
 #include "hilldem/labtests/specimen_io.hpp"
 #include "hilldem/labtests/study.hpp"
 #include "hilldem/labtests/t307.hpp"
@@ -110,29 +112,37 @@ void write_file(const fs::path& path, const std::string& text) {
 int run_locked(const Options& o, const Plan& plan, std::ostream* log);
 
 int run(const Options& o) {
+  // Under mpirun every rank runs the test on its part of the specimen; rank 0 logs and writes
+  // (docs/mpi.md, "The lab tests over ranks").
+  const std::unique_ptr<RunDecomposition> ranks = decomposed_run();
+  const bool root = !ranks || ranks->rank() == 0;
   Plan plan = build(o);  // throws InputError (exit 2) before anything is written
+  plan.study.genesis.ranks = ranks.get();
   if (o.threads > 0) omp_set_num_threads(o.threads);
-  std::ostream* log = o.quiet ? nullptr : &std::cout;
+  std::ostream* log = o.quiet || !root ? nullptr : &std::cout;
   // The folder is this process's while it runs (io/output_folder.hpp); an unwritable one is bad input.
-  const OutputLock lock(o.output, "-o");
-  plan.study.genesis.interrupt = lab_stop_check();
+  const OutputLock lock = lab_output_lock(o.output, ranks.get());
+  plan.study.genesis.interrupt = lab_stop_check(ranks.get());
   try {
     return run_locked(o, plan, log);
   } catch (const Interrupted& e) {
-    return report_lab_stop(e, o.output, "t307");
+    return root ? report_lab_stop(e, o.output, "t307") : 128 + stop_requested();
   }
 }
 
 int run_locked(const Options& o, const Plan& plan, std::ostream* log) {
   const fs::path out = o.output;
   PackedResult packed = make_packed(plan.study, plan.c.grading, plan.c.model, o.specimen.empty(), log);
-  Specimen s = std::move(packed.specimen);
+  Specimen s = std::move(packed.specimen);  // (over ranks: the whole specimen on every rank)
+  const std::size_t grains = s.sim.balls.size();
+  const RanksScope on_ranks(s, plan.c.wet ? plan.study.moisture_gap : 0.0);  // (the ghosts cover make_wet's gap)
   Class5Material m = plan.study.material;
   m.model = plan.c.model;
   finalize(s, m, plan.study.test_walls, plan.study.finalize, log);
   if (plan.c.wet) make_specimen_wet(s, plan.study.suction, plan.study.moisture_gap, plan.study.finalize, log);
   const SpecimenState start = measure(s);
   const T307Result r = run_t307(s, plan.test, log);
+  if (!is_root(s)) return 0;
 
   write_file(out / "t307_sequences.csv", r.sequences_csv());
   write_file(out / "t307_cycles.csv", r.cycles_csv());
@@ -142,7 +152,7 @@ int run_locked(const Options& o, const Plan& plan, std::ostream* log) {
       "hilldem t307: {} ({}), {} grains, vessel {:.1f} mm x {:.1f} mm, porosity {:.4f} at the start\n"
       "time-scaled AASHTO T 307: pulse {:g} s, rest {:g} s, settle {:g} s, {} cycles per sequence ({} conditioning), "
       "M_r and nu from the last {}; time step {:.3g} s; {} steps, {:.0f} s\n",
-      plan.c.name(), packed.file.empty() ? "packed here" : packed.file, s.sim.balls.size(), 2e3 * r.radius0, 1e3 * r.height0,
+      plan.c.name(), packed.file.empty() ? "packed here" : packed.file, grains, 2e3 * r.radius0, 1e3 * r.height0,
       start.porosity, tm.pulse_duration, tm.rest_duration, tm.settle_duration, tm.cycles, tm.conditioning_cycles,
       tm.averaged_cycles, r.timestep, r.steps, r.seconds);
   summary += r.text();

@@ -18,6 +18,8 @@
 #include "hilldem/bodies/clump_shapes.hpp"
 #include "hilldem/core/error.hpp"
 #include "hilldem/io/output_folder.hpp"
+#include "hilldem/io/runner.hpp"
+#include "hilldem/io/stop_signal.hpp"
 #include "hilldem/labtests/specimen_io.hpp"
 #include "hilldem/labtests/study.hpp"
 
@@ -143,23 +145,30 @@ std::pair<StudySettings, std::vector<CaseSpec>> build(const Options& o) {
   return {s, cases};
 }
 
-int run_locked(const Options& o, const StudySettings& settings, const std::vector<CaseSpec>& cases);
+int run_locked(const Options& o, const StudySettings& settings, const std::vector<CaseSpec>& cases, bool root);
 
 int run(const Options& o) {
+  // Under mpirun every rank runs every case on its part of the specimen, one case at a time; rank 0
+  // logs and writes (docs/mpi.md, "The lab tests over ranks").
+  const std::unique_ptr<RunDecomposition> ranks = decomposed_run();
+  const bool root = !ranks || ranks->rank() == 0;
   auto [settings, cases] = build(o);  // throws InputError (exit 2) before anything is written
+  settings.genesis.ranks = ranks.get();
+  if (ranks && ranks->size() > 1 && !settings.genesis.clump_template.empty())
+    throw InputError("--clump-template: clumps are not decomposed over MPI ranks yet (docs/mpi.md): run without mpirun");
   // The folder is this process's while it runs (io/output_folder.hpp); an unwritable one is bad input.
-  const OutputLock lock(settings.output_dir, "-o");
-  settings.genesis.interrupt = lab_stop_check();
+  const OutputLock lock = lab_output_lock(settings.output_dir, ranks.get());
+  settings.genesis.interrupt = lab_stop_check(ranks.get());
   try {
-    return run_locked(o, settings, cases);
+    return run_locked(o, settings, cases, root);
   } catch (const Interrupted& e) {
-    return report_lab_stop(e, settings.output_dir, "triaxial");
+    return root ? report_lab_stop(e, settings.output_dir, "triaxial") : 128 + stop_requested();
   }
 }
 
-int run_locked(const Options& o, const StudySettings& settings, const std::vector<CaseSpec>& cases) {
+int run_locked(const Options& o, const StudySettings& settings, const std::vector<CaseSpec>& cases, bool root) {
   if (o.threads > 0) omp_set_num_threads(o.threads);  // 0: OpenMP's default (OMP_NUM_THREADS or all cores)
-  std::ostream* log = o.quiet ? nullptr : &std::cout;
+  std::ostream* log = o.quiet || !root ? nullptr : &std::cout;
   if (log)
     *log << fmt::format("hilldem triaxial: {} case{} in a {:.0f} mm x {:.0f} mm vessel{}{}; output {}\n", cases.size(),
                         cases.size() > 1 ? "s" : "", 2e3 * settings.genesis.vessel_radius, 1e3 * settings.genesis.vessel_height,
@@ -177,6 +186,7 @@ int run_locked(const Options& o, const StudySettings& settings, const std::vecto
     const auto t0 = std::chrono::steady_clock::now();
     const std::clock_t c0 = std::clock();
     const std::vector<PackedResult> packed = make_all_packed(settings, cases, true, log);
+    if (!root) return 0;
     std::cout << "\n" << packing_table(packed);
     std::cout << "\nconverged when " << criterion_text(settings.genesis.packing.equilibrium) << "\n";
     std::cout << fmt::format("\nspecimens: {}/specimens/; {:.0f} s wall, {:.0f} s CPU\n", settings.output_dir,
@@ -185,6 +195,7 @@ int run_locked(const Options& o, const StudySettings& settings, const std::vecto
     return 0;
   }
   const StudyResult result = run_study(settings, cases, log);
+  if (!root) return 0;
   std::cout << "\n" << result.summary_markdown();
   std::cout << fmt::format("\nsummary: {}/summary.csv, {}/summary.md; {:.0f} s wall, {:.0f} s CPU in all\n", settings.output_dir,
                            settings.output_dir, result.seconds, result.cpu_seconds);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "hilldem/core/error.hpp"
+#include "hilldem/io/output_folder.hpp"
 
 namespace hilldem {
 class RunDecomposition;  // io/runner.hpp
@@ -62,8 +63,13 @@ int report_stop(int signal, std::int64_t step, double time, const std::string& c
 // The lab commands' graceful stop (lab_stop.cpp): lab_stop_check() installs the signal handlers and
 // returns the predicate for GenesisSpec::interrupt; report_lab_stop says where the test stopped and
 // which packed specimens were kept, and returns 128 + the signal number.
-std::function<bool()> lab_stop_check();
+// Over MPI ranks (ranks not null) the predicate is every rank's answer combined, asked by every rank
+// before every cycle, so that all stop at the same cycle.
+std::function<bool()> lab_stop_check(RunDecomposition* ranks = nullptr);
 int report_lab_stop(const Interrupted& e, const std::string& output_dir, const std::string& command);
+// A lab command's output folder lock (io/output_folder.hpp), taken by rank 0 alone over MPI ranks;
+// its refusal (InputError) is thrown on every rank.
+OutputLock lab_output_lock(const std::string& dir, RunDecomposition* ranks);
 
 // Options live as long as the app: each add_* keeps its state in a shared_ptr captured by `run`.
 std::vector<Command> add_scenario_commands(CLI::App& app);  // run, check, contacts, quantities

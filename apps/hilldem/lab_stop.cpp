@@ -10,13 +10,29 @@
 
 #include "commands.hpp"
 #include "hilldem/core/error.hpp"
+#include "hilldem/io/runner.hpp"
 #include "hilldem/io/stop_signal.hpp"
 
 namespace hilldem::cli {
 
-std::function<bool()> lab_stop_check() {
+std::function<bool()> lab_stop_check(RunDecomposition* ranks) {
   install_stop_handlers();
+  if (ranks) return [ranks] { return ranks->max(stop_requested()) != 0; };
   return [] { return stop_requested() != 0; };
+}
+
+OutputLock lab_output_lock(const std::string& dir, RunDecomposition* ranks) {
+  if (!ranks) return OutputLock(dir, "-o");
+  OutputLock lock;
+  std::string error;
+  if (ranks->rank() == 0) try {
+      lock = OutputLock(dir, "-o");
+    } catch (const InputError& e) {
+      error = e.what();
+    }
+  error = ranks->from_root(error);
+  if (!error.empty()) throw InputError(error);
+  return lock;
 }
 
 int report_lab_stop(const Interrupted& e, const std::string& output_dir, const std::string& command) {

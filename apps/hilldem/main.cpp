@@ -63,9 +63,9 @@ int main(int argc, char** argv) {
       if (c.sub && *c.sub) {
 #ifdef HILLDEM_MPI
         const std::string name = c.sub->get_name();
-        if (g_size > 1 && name != "bench" && name != "run" && name != "resume")
-          throw hilldem::InputError("'" + name + "' does not run decomposed over MPI ranks yet (only 'bench', 'run' "
-                                    "and 'resume' do, docs/mpi.md): run it without mpirun, or with -np 1");
+        if (g_size > 1 && name != "bench" && name != "run" && name != "resume" && name != "triaxial" && name != "t307")
+          throw hilldem::InputError("'" + name + "' does not run decomposed over MPI ranks yet (only 'bench', 'run', "
+                                    "'resume', 'triaxial' and 't307' do, docs/mpi.md): run it without mpirun, or with -np 1");
 #endif
         return c.run();
       }

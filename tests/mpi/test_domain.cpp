@@ -217,13 +217,3 @@ TEST(Domain, ServoOnAWallSumOverRanksGivesTheWholeRunBitwise) {
 
 }  // namespace
 }  // namespace hilldem
-
-int main(int argc, char** argv) {
-  hilldem::parallel::MpiSession mpi(argc, argv);
-  ::testing::InitGoogleTest(&argc, argv);
-  if (mpi.rank() != 0) {  // (one report: rank 0's; a failure elsewhere still fails mpirun's status)
-    ::testing::TestEventListeners& listeners = ::testing::UnitTest::GetInstance()->listeners();
-    delete listeners.Release(listeners.default_result_printer());
-  }
-  return RUN_ALL_TESTS();
-}

@@ -2,8 +2,17 @@
 # Every test runs under mpirun with 1, 2, 3 and 4 ranks, oversubscribed (this machine has 2 cores) and
 # allowed as root (OpenMPI refuses root otherwise), one thread a rank.
 set(HILLDEM_MPIRUN ${MPIEXEC_EXECUTABLE} --allow-run-as-root --oversubscribe)
-add_executable(hilldem_mpi_tests mpi/test_domain.cpp)
+add_executable(hilldem_mpi_tests mpi/test_domain.cpp mpi/gtest_main.cpp)
 target_link_libraries(hilldem_mpi_tests PRIVATE hilldem_parallel GTest::gtest)
+# The lab-test drivers (finalize, make_wet, triaxial, T 307, genesis from a seed) over N ranks against
+# one process (tests/mpi/test_lab_over_ranks.cpp).
+add_executable(hilldem_mpi_lab_tests mpi/test_lab_over_ranks.cpp mpi/gtest_main.cpp)
+target_link_libraries(hilldem_mpi_lab_tests PRIVATE hilldem_parallel GTest::gtest)
+target_compile_definitions(hilldem_mpi_lab_tests PRIVATE HILLDEM_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+foreach(ranks 1 2 3 4)
+  add_test(NAME mpi.lab_drivers_${ranks}_ranks COMMAND ${HILLDEM_MPIRUN} -np ${ranks} $<TARGET_FILE:hilldem_mpi_lab_tests>)
+  set_tests_properties(mpi.lab_drivers_${ranks}_ranks PROPERTIES TIMEOUT 600 LABELS mpi ENVIRONMENT "OMP_NUM_THREADS=1")
+endforeach()
 foreach(ranks 1 2 3 4)
   # The bench bed decomposed gives the digest of one process (cli.bench_digest_*).
   add_test(NAME mpi.bench_digest_${ranks}_ranks
@@ -57,6 +66,15 @@ list(APPEND HILLDEM_MPI_SCENARIO_TESTS mpi.checkpoint_of_4_ranks_resumes_on_2_an
 string(REPLACE ";" " " HILLDEM_MPIRUN_LINE "${HILLDEM_MPIRUN}")
 set_tests_properties(${HILLDEM_MPI_SCENARIO_TESTS} PROPERTIES TIMEOUT 300 LABELS mpi
   ENVIRONMENT "OMP_NUM_THREADS=1;MPIRUN=${HILLDEM_MPIRUN_LINE}")
+# `hilldem triaxial` (a wet case from a saved specimen, and a genesis from the seed) and `hilldem t307`
+# over N ranks: every CSV file they write is one process's, byte for byte (tests/mpi/lab_over_ranks.sh).
+foreach(ranks 1 2 3 4)
+  add_test(NAME mpi.lab_commands_${ranks}_ranks
+    COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/mpi/lab_over_ranks.sh $<TARGET_FILE:hilldem>
+            ${CMAKE_CURRENT_BINARY_DIR}/mpi_lab_${ranks} ${CMAKE_CURRENT_SOURCE_DIR}/data ${ranks})
+  set_tests_properties(mpi.lab_commands_${ranks}_ranks PROPERTIES TIMEOUT 600 LABELS mpi
+    ENVIRONMENT "OMP_NUM_THREADS=1;MPIRUN=${HILLDEM_MPIRUN_LINE}")
+endforeach()
 # Commands that do not run decomposed yet say so once, with exit status 2.
 add_test(NAME mpi.run_on_two_ranks_exits_2
   COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "does not run decomposed"

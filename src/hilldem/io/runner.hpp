@@ -43,6 +43,10 @@ class RunDecomposition {
   // Make sim, the whole run (the same on every rank), this rank's part. reach [m]: the largest
   // distance between two balls' surfaces a stage asks for (make_wet's gap), so the ghosts cover it.
   virtual void attach(Simulation& sim, double reach) = 0;
+  // Let go of the attached Simulation (its domain set to null; it keeps this rank's part), so that
+  // another one can be attached (the lab tests attach one specimen after another; attach detaches
+  // the previous one first). Call it before the attached Simulation ends. Nothing when none is attached.
+  virtual void detach() = 0;
   virtual int rank() const = 0;
   virtual int size() const = 0;
   // Whether this rank owns local ball i (after attach).

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <bit>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -16,6 +17,9 @@
 #include "hilldem/bodies/clump_shapes.hpp"
 #include "hilldem/control/controller_scope.hpp"
 #include "hilldem/core/error.hpp"
+#include "hilldem/io/checkpoint.hpp"
+#include "hilldem/io/runner.hpp"
+#include "hilldem/io/state_io.hpp"
 #include "hilldem/labtests/measure_region.hpp"
 
 namespace hilldem {
@@ -243,7 +247,80 @@ double interior_porosity(const MeasurementCylinder& m, const Simulation& sim) {
   return v > 0.0 ? 1.0 - solid / v : 0.0;
 }
 
+// ---- over MPI ranks (docs/mpi.md, "The lab tests over ranks") ----
+
+bool decomposed(const Specimen& s) { return s.ranks && s.sim.domain; }
+bool is_root(const Specimen& s) { return !s.ranks || s.ranks->rank() == 0; }
+
+void attach_to_ranks(Specimen& s, double reach) {
+  if (!s.ranks || s.sim.domain) return;
+  // Taken here, on the whole run: a rank's balls (owned and ghosts) are not the grains.
+  s.whole_grains = grain_count(s.sim);
+  s.whole_solid = solid_volume(s.sim);
+  s.ranks->attach(s.sim, reach);
+}
+
+void detach_from_ranks(Specimen& s) {
+  if (decomposed(s)) s.ranks->detach();
+}
+
+Specimen whole_run(Specimen& s) {
+  if (!decomposed(s)) return s;
+  RunDecomposition& r = *s.ranks;
+  // With the cycle state, as a checkpoint of a decomposed run is written and resumed: the copy
+  // continues as the whole run would, attached again or not.
+  const Simulation gathered = r.gather(true);
+  std::string bytes;
+  if (r.rank() == 0) {
+    CheckpointWriter w;
+    write_simulation(w, gathered);
+    bytes = w.bytes();
+  }
+  bytes = r.from_root(bytes);
+  r.detach();
+  Specimen out = s;  // (the metadata; its sim, this rank's part, is replaced)
+  read_simulation(CheckpointReader::from_bytes(std::move(bytes), "the gathered specimen"), out.sim);
+  out.sim.interrupt = s.sim.interrupt;
+  return out;
+}
+
+std::string on_whole_run_bytes(const Specimen& s, const std::function<std::string(const Specimen&)>& f) {
+  RunDecomposition& r = *s.ranks;
+  Simulation gathered = r.gather(false);
+  std::string bytes;
+  if (r.rank() == 0) {
+    Specimen whole = s;  // (the metadata; this rank's part replaced by the whole run)
+    whole.sim = std::move(gathered);
+    whole.ranks = nullptr;
+    bytes = f(whole);
+  }
+  return r.from_root(bytes);
+}
+
+double whole_run_ratio(const Specimen& s) {
+  if (!decomposed(s)) return s.sim.mean_unbalanced_ratio();
+  return on_whole_run<double>(s, [](const Specimen& w) { return w.sim.mean_unbalanced_ratio(); });
+}
+
+std::size_t whole_run_rows(const Specimen& s, bool (*pred)(const ContactStore&, std::size_t)) {
+  const ContactStore& c = s.sim.contacts;
+  const bool ranks = decomposed(s);
+  std::uint64_t n = 0;
+  for (std::size_t k = 0; k < c.size(); ++k) n += pred(c, k) && (!ranks || s.ranks->owns(c.key[k].a));
+  return static_cast<std::size_t>(ranks ? s.ranks->sum(n) : n);
+}
+
+namespace {
+// The largest over the ranks of x ≥ 0: non-negative doubles order as their bit patterns do as
+// integers, so an integer maximum gives it exactly.
+double max_over_ranks(const Specimen& s, double x) {
+  if (!decomposed(s)) return x;
+  return std::bit_cast<double>(s.ranks->max(std::bit_cast<std::int64_t>(x)));
+}
+}  // namespace
+
 SpecimenState measure(const Specimen& s, bool interior) {
+  if (decomposed(s)) return on_whole_run<SpecimenState>(s, [interior](const Specimen& w) { return measure(w, interior); });
   const Simulation& sim = s.sim;
   SpecimenState st;
   st.grains = grain_count(sim);
@@ -318,6 +395,7 @@ Specimen make_cloud(const GenesisSpec& spec) {
   s.seed = p.seed;
   s.pressure = p.equilibrium.pressure;
   s.packed_with = p.contact.model;
+  s.ranks = spec.ranks;
   Simulation& sim = s.sim;
   sim.interrupt = spec.interrupt;
   sim.settings.local_damping = p.local_damping;
@@ -410,8 +488,11 @@ PhaseReport relax_cloud(Specimen& s, const PackingSettings& p, std::ostream* log
   const auto t0 = std::chrono::steady_clock::now();
   Simulation& sim = s.sim;
   s.vessel.stop(sim);
-  double d_min = std::numeric_limits<double>::infinity();
-  for (double r : sim.balls.radius) d_min = std::min(d_min, 2.0 * r);
+  const double d_min = on_whole_run<double>(s, [](const Specimen& w) {
+    double d = std::numeric_limits<double>::infinity();
+    for (double r : w.sim.balls.radius) d = std::min(d, 2.0 * r);
+    return d;
+  });
   const double cap = p.cloud_speed_limit;
   // A clump's speed is capped at its centre of mass, and its spin so that no point of it within its
   // enclosing radius moves faster than the cap from the turn (ω and L_b scaled together: ω = R I⁻¹ L_b).
@@ -438,18 +519,21 @@ PhaseReport relax_cloud(Specimen& s, const PackingSettings& p, std::ostream* log
     }
   });
   const std::int64_t start = sim.steps;
+  // The whole run's deepest overlap [m] (over ranks: each row by the owner of its first ball).
+  const bool ranks = decomposed(s);
   auto worst_overlap = [&] {
     double worst = 0.0;
     for (std::size_t c = 0; c < sim.contacts.size(); ++c)
-      if (sim.contacts.exists[c] && sim.contacts.active[c]) worst = std::max(worst, -sim.contacts.gap[c]);
-    return worst;
+      if (sim.contacts.exists[c] && sim.contacts.active[c] && (!ranks || s.ranks->owns(sim.contacts.key[c].a)))
+        worst = std::max(worst, -sim.contacts.gap[c]);
+    return max_over_ranks(s, worst);
   };
   sim.update_forces();
-  while (worst_overlap() > p.cloud_overlap * d_min) {
+  for (double worst = worst_overlap(); worst > p.cloud_overlap * d_min; worst = worst_overlap()) {
     if (sim.steps - start >= p.cloud_max_steps) {
       if (log)
         *log << fmt::format("cloud: overlaps not below {:g} x D_min after {} steps (worst {:.3g} mm); packing anyway\n",
-                            p.cloud_overlap, p.cloud_max_steps, worst_overlap() * 1e3);
+                            p.cloud_overlap, p.cloud_max_steps, worst * 1e3);
       break;
     }
     sim.cycle(50);
@@ -484,7 +568,7 @@ PhaseReport servo_equilibrium(Specimen& s, const EquilibriumSettings& e, const s
   const std::int64_t progress_every = 20000;
   std::int64_t next_progress = start + progress_every;
   auto within = [&](double stress) { return std::abs(stress - e.pressure) <= e.pressure_tolerance * e.pressure; };
-  const double solid = solid_volume(sim);
+  const double solid = decomposed(s) ? s.whole_solid : solid_volume(sim);
   auto porosity = [&] { return 1.0 - solid / s.vessel.volume(sim); };
   PorosityHistory history(e.porosity_window);
   history.add(sim.steps, porosity());
@@ -492,17 +576,21 @@ PhaseReport servo_equilibrium(Specimen& s, const EquilibriumSettings& e, const s
     sim.drive(check_every, plan);
     history.add(sim.steps, porosity());
     const double sr = s.vessel.radial_stress(sim), sb = s.vessel.bottom_stress(sim), st = s.vessel.top_stress(sim);
-    if (within(sr) && within(sb) && within(st) && sim.mean_unbalanced_ratio() <= e.ratio && history.converged(e.porosity_change))
+    // (The walls' sums are the whole run's on every rank, so every rank takes the same branches and
+    // meets whole_run_ratio's collective together.)
+    if (within(sr) && within(sb) && within(st) && whole_run_ratio(s) <= e.ratio && history.converged(e.porosity_change))
       break;
-    if (log && sim.steps >= next_progress) {
+    if (sim.steps >= next_progress && (log || decomposed(s))) {  // (over ranks every rank: the ratio is collective)
       next_progress += progress_every;
+      const double ratio = whole_run_ratio(s);
       double dn = 0.0;
       const bool have = history.change_per_1000(dn);
-      *log << fmt::format("  {} step {:>8}: n {:.4f}  sigma_r {:.1f}  sigma_b {:.1f}  sigma_t {:.1f} kPa  ratio {:.2e}  dn {} per 1000 steps  "
+      if (log)
+        *log << fmt::format("  {} step {:>8}: n {:.4f}  sigma_r {:.1f}  sigma_b {:.1f}  sigma_t {:.1f} kPa  ratio {:.2e}  dn {} per 1000 steps  "
                           "dt {:.3g} s\n",
-                          name, sim.steps - start, porosity(), sr / 1e3, sb / 1e3, st / 1e3, sim.mean_unbalanced_ratio(),
+                          name, sim.steps - start, porosity(), sr / 1e3, sb / 1e3, st / 1e3, ratio,
                           have ? fmt::format("{:.1e}", dn) : std::string("n/a"), sim.last_dt);
-      log->flush();
+      if (log) log->flush();
     }
     if (sim.steps - start >= e.max_steps) {
       s.vessel.stop(sim);
@@ -510,7 +598,7 @@ PhaseReport servo_equilibrium(Specimen& s, const EquilibriumSettings& e, const s
       const bool have = history.change_per_1000(dn);
       throw RunError(fmt::format("{}: not converged after {} steps ({}): sigma_r {:.2f}, sigma_bottom {:.2f}, sigma_top {:.2f} kPa, "
                                  "ratio {:.3g}, porosity change {} per 1,000 steps",
-                                 name, e.max_steps, criterion_text(e), sr / 1e3, sb / 1e3, st / 1e3, sim.mean_unbalanced_ratio(),
+                                 name, e.max_steps, criterion_text(e), sr / 1e3, sb / 1e3, st / 1e3, whole_run_ratio(s),
                                  have ? fmt::format("{:.2g}", dn) : std::string("n/a")));
     }
   }
@@ -536,8 +624,10 @@ Specimen pack_specimen(const GenesisSpec& spec, std::ostream* log) {
                         spec.grading.name, measure(s).porosity, 2e3 * spec.vessel_radius,
                         1e3 * spec.vessel_height, spec.packing.seed, seconds_since(t0), to_string(spec.packing.contact.model),
                         spec.packing.contact.fric, criterion_text(spec.packing.equilibrium));
+  const RanksScope ranks(s, 0.0);
   relax_cloud(s, spec.packing, log);
   servo_equilibrium(s, spec.packing.equilibrium, "packing", log);
+  if (decomposed(s)) return whole_run(s);
   return s;
 }
 
@@ -556,7 +646,13 @@ PhaseReport make_specimen_wet(Specimen& s, double suction, double gap, const Equ
   bool hill = false;
   for (const ModelRule& r : s.sim.table.rules) hill = hill || (r.kind == ContactKind::BallBall && r.model == ModelKind::Hill);
   if (!hill) throw InputError("only a hill material can be made wet (the linear model has no liquid bridges)");
-  const std::size_t wet = s.sim.make_wet(suction, gap);
+  std::size_t wet = s.sim.make_wet(suction, gap);
+  // Over ranks each rank wets its part (the ghosts cover the gap: attach_to_ranks' reach); the count
+  // is the whole run's, each wet row counted by the owner of its first ball.
+  if (decomposed(s))
+    wet = whole_run_rows(s, [](const ContactStore& c, std::size_t k) {
+      return c.exists[k] && c.model[k] == ModelKind::Hill && c.moisture[k] == Moisture::Wet;
+    });
   s.wet = true;
   if (log) *log << fmt::format("make_wet({:g} kPa, {:g} mm): {} wet contacts\n", suction / 1e3, gap * 1e3, wet);
   return servo_equilibrium(s, e, "wet " + s.material, log);

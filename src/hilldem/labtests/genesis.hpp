@@ -5,9 +5,11 @@
 #pragma once
 
 #include <cstdint>
+#include <cstring>
 #include <functional>
 #include <iosfwd>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "hilldem/bodies/clump_template.hpp"
@@ -18,6 +20,8 @@
 #include "hilldem/labtests/vessel.hpp"
 
 namespace hilldem {
+
+class RunDecomposition;  // io/runner.hpp
 
 // Servo-controlled equilibrium of the three vessel walls at one pressure. Converged when, at a check,
 // all three hold (lab-tests.md §3.4): every wall within ε_P·P of P; the mean unbalanced-force ratio
@@ -86,6 +90,9 @@ struct GenesisSpec {
   // make_packed to a specimen it loads, so that a lab test stops between two cycles when it
   // answers true (the CLI: on SIGINT, SIGTERM, SIGHUP), throwing Interrupted.
   std::function<bool()> interrupt;
+  // Not physics: the run over MPI ranks this process is one rank of (docs/mpi.md, "The lab tests over
+  // ranks"), given to every Specimen made from this spec (Specimen::ranks); null: one process.
+  RunDecomposition* ranks = nullptr;
 };
 // Throws InputError naming the first bad value.
 void validate(const GenesisSpec& spec);
@@ -143,7 +150,61 @@ struct Specimen {
   // The grains' sizes [m]: a ball's diameter; a clump's size by clump_size (the equal-volume
   // diameter (6V/π)^(1/3), or the enclosing diameter 2 max_k(|p_k| + r_k)), clumps first in clump order.
   std::vector<double> diameters() const;
+  // Over MPI ranks (docs/mpi.md, "The lab tests over ranks"): the run this process is one rank of, or
+  // null (one process). While attached (attach_to_ranks) `sim` is this rank's part, and every
+  // reading the drivers take of the balls or contacts is the whole run's, the same bits for any rank
+  // count. A copy keeps the pointer and is not attached: attach it on its own.
+  RunDecomposition* ranks = nullptr;
+  // The whole run's grain count and solid volume [m³], taken when attached (radii do not change).
+  std::size_t whole_grains = 0;
+  double whole_solid = 0.0;
 };
+
+// Whether s.sim is one rank's part of a run over MPI ranks (attached), and rank 0 or no ranks (the
+// process that writes files and logs).
+bool decomposed(const Specimen& s);
+bool is_root(const Specimen& s);
+// Make s.sim, the whole run on every rank (the same bits everywhere), this rank's part of it: its
+// balls and ghosts to `reach` [m] beyond their surfaces (make_wet's gap when the specimen is to be
+// wetted). Nothing when s.ranks is null or s is attached already.
+void attach_to_ranks(Specimen& s, double reach);
+// Let s go (it keeps this rank's part). Nothing when not attached.
+void detach_from_ranks(Specimen& s);
+// attach_to_ranks for a scope: detaches when it ends (an exception included), before s ends.
+class RanksScope {
+ public:
+  RanksScope(Specimen& s, double reach) : s_(s) { attach_to_ranks(s, reach); }
+  ~RanksScope() { detach_from_ranks(s_); }
+  RanksScope(const RanksScope&) = delete;
+  RanksScope& operator=(const RanksScope&) = delete;
+
+ private:
+  Specimen& s_;
+};
+// The whole specimen on every rank, detached (gathered with its cycle state to rank 0 and sent to
+// every rank as checkpoint bytes: it continues as the whole run would); s is detached. Collective.
+// Without ranks, a copy.
+Specimen whole_run(Specimen& s);
+// Rank 0's f(the whole specimen), on every rank: gathered to rank 0, f computed there, its bytes sent
+// to every rank. T trivially copyable. Collective when decomposed; else f(s).
+std::string on_whole_run_bytes(const Specimen& s, const std::function<std::string(const Specimen&)>& f);
+template <class T, class F>
+T on_whole_run(const Specimen& s, F&& f) {
+  static_assert(std::is_trivially_copyable_v<T>);
+  if (!decomposed(s)) return f(s);
+  const std::string bytes = on_whole_run_bytes(s, [&](const Specimen& whole) {
+    const T v = f(whole);
+    return std::string(reinterpret_cast<const char*>(&v), sizeof v);
+  });
+  T out;
+  std::memcpy(&out, bytes.data(), sizeof out);
+  return out;
+}
+// The mean unbalanced-force ratio of the whole run [-] (Simulation::mean_unbalanced_ratio).
+double whole_run_ratio(const Specimen& s);
+// The whole run's count of the rows that satisfy pred(store, row): each row counted by the owner of
+// its first ball, the counts summed over the ranks (integers: exact in any order).
+std::size_t whole_run_rows(const Specimen& s, bool (*pred)(const ContactStore&, std::size_t));
 
 // The grains: the clumps and the balls that are not pebbles.
 std::size_t grain_count(const Simulation& sim);
@@ -177,7 +238,9 @@ PhaseReport relax_cloud(Specimen& s, const PackingSettings& p, std::ostream* log
 // end. Throws RunError after max_steps.
 PhaseReport servo_equilibrium(Specimen& s, const EquilibriumSettings& e, const std::string& name, std::ostream* log);
 // make_cloud + relax_cloud + servo_equilibrium: the packed (frictionless) specimen, packed with
-// spec.packing.contact (the material's own model by default).
+// spec.packing.contact (the material's own model by default). With spec.ranks, the cloud (made
+// whole on every rank, from the seed) is relaxed and packed decomposed, and the packed specimen is
+// the whole run on every rank, detached (whole_run).
 Specimen pack_specimen(const GenesisSpec& spec, std::ostream* log);
 
 // Finalization: grain properties and the material's assignment table installed on every contact

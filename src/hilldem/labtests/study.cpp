@@ -24,6 +24,7 @@
 
 #include "hilldem/core/error.hpp"
 #include "hilldem/engine/thread_budget.hpp"
+#include "hilldem/io/runner.hpp"
 #include "hilldem/labtests/specimen_io.hpp"
 
 namespace hilldem {
@@ -507,6 +508,7 @@ PackedResult make_packed(const StudySettings& settings, const std::string& gradi
   if (!settings.specimen_file.empty()) {
     p.specimen = load_packed_specimen(settings.specimen_file, &ps);
     p.specimen.sim.interrupt = settings.genesis.interrupt;
+    p.specimen.ranks = settings.genesis.ranks;  // (the whole specimen on every rank: each reads the file)
     p.file = settings.specimen_file;
     if (log)
       *log << fmt::format("specimen {}: {} grains of {} packed at {:g} kPa (seed {})\n", settings.specimen_file,
@@ -525,10 +527,10 @@ PackedResult make_packed(const StudySettings& settings, const std::string& gradi
     std::tie(g.vessel_radius, g.vessel_height) = vessel_for(settings, grading);
     g.grain = settings.material;
     g.packing = ps;
-    p.specimen = pack_specimen(g, log);
+    p.specimen = pack_specimen(g, log);  // (with ranks: the whole run on every rank)
     if (save) {
       p.file = (dir / (stem + "_packed.csv")).string();
-      save_packed_specimen(p.specimen, g.packing, p.file);
+      if (is_root(p.specimen)) save_packed_specimen(p.specimen, g.packing, p.file);
       if (log) *log << "packed specimen saved: " << p.file << "\n";
     }
   }
@@ -538,7 +540,7 @@ PackedResult make_packed(const StudySettings& settings, const std::string& gradi
     throw RunError(fmt::format("{}: the packed specimen is physically impossible: {}", p.file.empty() ? stem : p.file, joined(bad)));
   p.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (log) *log << p.report.text() << state_text("packed", p.state);
-  if (save && settings.specimen_file.empty()) {
+  if (save && settings.specimen_file.empty() && is_root(p.specimen)) {
     write_file(dir / (stem + "_gsd.csv"), p.report.csv());
     const auto [vr, vh] = vessel_for(settings, grading);
     std::string gen = fmt::format("grading {}, seed {}, vessel {:g} mm x {:g} mm, P_m {:g} kPa, packed with {} contacts, friction {:g}\n",
@@ -721,7 +723,10 @@ std::vector<PackedResult> make_all_packed(const StudySettings& settings, const s
   for (const PackingKey& k : packings)
     labels.push_back(loaded ? "specimen " + k.name : "packing " + k.name + " " + to_string(k.model));
   // Prefixed log lines whenever the study runs more than one job, so that its whole log reads alike.
-  const bool prefix = resolved_jobs(settings.jobs, cases.size()) > 1;
+  // Over MPI ranks one at a time, on the main thread (MPI is called from it alone), each with the
+  // caller's threads.
+  const bool ranks = settings.genesis.ranks != nullptr;
+  const bool prefix = !ranks && resolved_jobs(settings.jobs, cases.size()) > 1;
   // The longest expected first (the packing time grows with the grains; hill packing is the slower).
   std::vector<std::size_t> order(packings.size());
   std::vector<double> cost(packings.size());
@@ -732,7 +737,8 @@ std::vector<PackedResult> make_all_packed(const StudySettings& settings, const s
     cost[i] = grains * (packings[i].model == GrainModel::Hill ? 1.5 : 1.0);
   }
   std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return cost[x] > cost[y]; });
-  for_each_job(packings.size(), resolved_jobs(settings.jobs, packings.size()), settings.jobs != 1, prefix, labels, log, order,
+  for_each_job(packings.size(), ranks ? 1 : resolved_jobs(settings.jobs, packings.size()), !ranks && settings.jobs != 1, prefix,
+               labels, log, order,
                [&](std::size_t i, std::ostream* out) {
                  if (out) *out << fmt::format("\n=== {} ===\n", labels[i]) << std::flush;
                  packed[i] = make_packed(settings, packings[i].grading, packings[i].model, save, out);
@@ -745,7 +751,10 @@ StudyResult run_study(const StudySettings& settings, const std::vector<CaseSpec>
   const auto t0 = std::chrono::steady_clock::now();
   const std::clock_t c0 = std::clock();
   const fs::path out = settings.output_dir;
-  fs::create_directories(out);
+  // Over MPI ranks rank 0 writes every file; every rank runs every case, one at a time.
+  RunDecomposition* const ranks = settings.genesis.ranks;
+  const bool root = !ranks || ranks->rank() == 0;
+  if (root) fs::create_directories(out);
   // One packing per grading, all before the first case (at once when jobs allow).
   const std::vector<PackedResult> all_packed = make_all_packed(settings, cases, settings.save_specimens, log);
   // Each case's packing, looked up once (resolving a grading may read its file), before any job starts.
@@ -765,7 +774,7 @@ StudyResult run_study(const StudySettings& settings, const std::vector<CaseSpec>
   study.criterion = criterion_text(settings.genesis.packing.equilibrium);
   std::vector<std::string> names;
   for (const CaseSpec& c : cases) names.push_back(c.name());
-  const int jobs = resolved_jobs(settings.jobs, cases.size());
+  const int jobs = ranks ? 1 : resolved_jobs(settings.jobs, cases.size());
   // Several at once: the longest expected first, so that the longest case does not start last (the
   // time of a case grows with its grains; measured on the study, a hill case takes ≈ 1.5 × a linear
   // one and a wet case ≈ 1.5 × a dry one). The order changes no result.
@@ -777,7 +786,7 @@ StudyResult run_study(const StudySettings& settings, const std::vector<CaseSpec>
               (cases[i].model == GrainModel::Hill ? 1.5 : 1.0) * (cases[i].wet ? 1.5 : 1.0);
   }
   std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return cost[x] > cost[y]; });
-  for_each_job(cases.size(), jobs, settings.jobs != 1, jobs > 1, names, log, order, [&](std::size_t i, std::ostream* clog) {
+  for_each_job(cases.size(), jobs, !ranks && settings.jobs != 1, jobs > 1, names, log, order, [&](std::size_t i, std::ostream* clog) {
     const CaseSpec& c = cases[i];
     const PackedResult& p = *packed_of[i];
     if (clog) *clog << fmt::format("\n=== {} ===\n", c.name()) << std::flush;
@@ -791,6 +800,8 @@ StudyResult run_study(const StudySettings& settings, const std::vector<CaseSpec>
     r.clump_template = p.specimen.clump_template;
     r.packing_file = p.file;
     Specimen s = p.specimen;  // a copy: every case starts from the same packed state
+    // Over ranks this case's part of it; the ghosts cover make_wet's gap.
+    const RanksScope on_ranks(s, c.wet ? settings.moisture_gap : 0.0);
     Class5Material m = settings.material;
     m.model = c.model;
     EquilibriumSettings e = settings.finalize;
@@ -813,6 +824,10 @@ StudyResult run_study(const StudySettings& settings, const std::vector<CaseSpec>
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - tc).count();
     const fs::path dir = out / c.name();
     r.dir = dir.string();
+    if (!root) {
+      done[i] = std::move(r);  // (one case at a time over ranks)
+      return;
+    }
     write_file(dir / "history.csv", r.test.history_csv());
     write_file(dir / "loops.csv", loops_csv(r.test.loops));
     write_file(dir / "gsd.csv", r.grading.csv());
@@ -836,8 +851,10 @@ StudyResult run_study(const StudySettings& settings, const std::vector<CaseSpec>
   for (auto& d : done) study.cases.push_back(std::move(*d));
   study.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   study.cpu_seconds = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
-  write_file(out / "summary.csv", study.summary_csv());
-  write_file(out / "summary.md", study.summary_markdown());
+  if (root) {
+    write_file(out / "summary.csv", study.summary_csv());
+    write_file(out / "summary.md", study.summary_markdown());
+  }
   return study;
 }
 

@@ -197,9 +197,19 @@ TriaxialResult run_triaxial(Specimen& s, const TriaxialSettings& t, std::ostream
     return r;
   };
   auto record = [&](TriaxialRow r) {
-    const SpecimenState st = measure(s, false);
-    r.porosity = st.porosity;
-    r.coordination = st.coordination;
+    if (decomposed(s)) {
+      // Over ranks without a gather: measure's formulas on the whole run's grains and solid volume
+      // (taken when attached) and its touching grain-grain rows, an integer sum over the ranks.
+      r.porosity = 1.0 - s.whole_solid / v.volume(sim);
+      const std::size_t touching = whole_run_rows(s, [](const ContactStore& c, std::size_t k) {
+        return c.exists[k] && c.key[k].kind == ContactKind::BallBall && c.active[k] && c.gap[k] < 0.0;
+      });
+      r.coordination = s.whole_grains > 0 ? 2.0 * static_cast<double>(touching) / static_cast<double>(s.whole_grains) : 0.0;
+    } else {
+      const SpecimenState st = measure(s, false);
+      r.porosity = st.porosity;
+      r.coordination = st.coordination;
+    }
     res.history.push_back(r);
     last_rec_eps = r.eps_a;
   };

@@ -12,8 +12,15 @@ RunOverRanks::~RunOverRanks() {
 }
 
 void RunOverRanks::attach(Simulation& sim, double reach) {
+  detach();
   domain_ = std::make_unique<Domain>(comm_, sim, reach);
   sim_ = &sim;
+}
+
+void RunOverRanks::detach() {
+  if (sim_) sim_->domain = nullptr;
+  sim_ = nullptr;
+  domain_.reset();
 }
 
 std::int64_t RunOverRanks::from_root(std::int64_t v) {

@@ -18,6 +18,7 @@ class RunOverRanks final : public RunDecomposition {
   RunOverRanks& operator=(const RunOverRanks&) = delete;
 
   void attach(Simulation& sim, double reach) override;
+  void detach() override;
   int rank() const override { return rank_; }
   int size() const override { return size_; }
   bool owns(std::size_t local) const override { return domain_->owns(local); }
