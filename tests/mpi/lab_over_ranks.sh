@@ -2,7 +2,8 @@
 # tests/mpi/tests.cmake: `hilldem triaxial` and `hilldem t307` under mpirun -np N against one process.
 #   lab_over_ranks.sh HILLDEM WORKDIR DATA N
 # On the miniature specimen (DATA/labtests/mini_packed.csv, grading DATA/labtests/fine.csv): a wet
-# triaxial case (finalize, make_wet, one cycle, the final load), a short T 307 (conditioning and four
+# triaxial case at two confinements (two cases, each a copy of the specimen attached on its own:
+# finalize, make_wet, the confining phase at 100 kPa, one cycle, the final load), a short T 307 (conditioning and four
 # sequences) and a genesis from the seed in a small vessel (--pack-only). Every CSV file they write
 # (histories, loops, the summary less its two columns of seconds, the sequences, the cycles, the fit,
 # the realised grading, the packed specimen) is byte for byte the one-process run's.
@@ -18,7 +19,7 @@ same() {  # what, expected file, actual file
 }
 drop_seconds() { awk -F, -v OFS=, '{NF -= 2; print}' "$1"; }  # summary.csv's packing_seconds and seconds
 triaxial=(triaxial --specimen "$data/labtests/mini_packed.csv" --grading "$data/labtests/fine.csv" --wet --cycles 0.02
-          --final-strain 0.06 --strain-rate 0.1 --final-strain-rate 0.5 --threads 1 --no-plot -q)
+          --final-strain 0.06 --strain-rate 0.1 --final-strain-rate 0.5 --confinement 100e3,150e3 --threads 1 --no-plot -q)
 t307=(t307 --specimen "$data/labtests/mini_packed.csv" --grading "$data/labtests/fine.csv" --sequences 0,1,7,11,14 --cycles 2
       --averaged-cycles 1 --conditioning-cycles 1 --pulse-duration 5e-3 --rest-duration 2e-3 --settle-duration 1e-3
       --threads 1 --no-plot -q)
@@ -33,8 +34,10 @@ for run in one ranks; do
     || { echo "FAIL: genesis ($run)"; cat "$work/$run.genesis.out"; exit 1; }
   drop_seconds "$work/$run/triaxial/summary.csv" > "$work/$run.summary.csv"
 done
-for f in history.csv loops.csv gsd.csv; do
-  same "triaxial fine_Hill_wet/$f on $n ranks" "$work/one/triaxial/fine_Hill_wet/$f" "$work/ranks/triaxial/fine_Hill_wet/$f"
+for c in fine_Hill_wet_100kPa fine_Hill_wet_150kPa; do
+  for f in history.csv loops.csv gsd.csv; do
+    same "triaxial $c/$f on $n ranks" "$work/one/triaxial/$c/$f" "$work/ranks/triaxial/$c/$f"
+  done
 done
 same "triaxial summary.csv (less its seconds) on $n ranks" "$work/one.summary.csv" "$work/ranks.summary.csv"
 for f in t307_sequences.csv t307_cycles.csv t307_fit.csv; do
