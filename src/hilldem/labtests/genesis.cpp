@@ -254,6 +254,9 @@ bool is_root(const Specimen& s) { return !s.ranks || s.ranks->rank() == 0; }
 
 void attach_to_ranks(Specimen& s, double reach) {
   if (!s.ranks || s.sim.domain) return;
+  // (Domain::gather, which the readings use, carries no clumps yet: refused on one rank too.)
+  if (!s.sim.clumps.empty())
+    throw InputError("a specimen of clumps does not run over MPI ranks yet (docs/mpi.md): run it without mpirun");
   // Taken here, on the whole run: a rank's balls (owned and ghosts) are not the grains.
   s.whole_grains = grain_count(s.sim);
   s.whole_solid = solid_volume(s.sim);

@@ -166,7 +166,8 @@ bool decomposed(const Specimen& s);
 bool is_root(const Specimen& s);
 // Make s.sim, the whole run on every rank (the same bits everywhere), this rank's part of it: its
 // balls and ghosts to `reach` [m] beyond their surfaces (make_wet's gap when the specimen is to be
-// wetted). Nothing when s.ranks is null or s is attached already.
+// wetted). Nothing when s.ranks is null or s is attached already. InputError for a specimen of
+// clumps (not decomposed yet).
 void attach_to_ranks(Specimen& s, double reach);
 // Let s go (it keeps this rank's part). Nothing when not attached.
 void detach_from_ranks(Specimen& s);
