@@ -333,7 +333,7 @@ Specimen make_cloud(const GenesisSpec& spec) {
   const bool clumps = !spec.clump_mix.empty();
   s.clump_mix = spec.clump_mix;
   s.clump_size = spec.clump_size;
-  // Per template: its unit (pebbles of radius 1), its volume factor f and its enclosing diameter per
+  // Per template: its unit (as named_template makes it), its volume factor f and its enclosing diameter per
   // size. A clump of size d by the chosen measure has volume f π d³/6: f = 1 for the equal-volume
   // diameter, below 1 for the enclosing one. The grading is sampled for the sphere volume
   // Σ_t (1 − n_c) V_vessel w_t / f_t (w_t the template's solid fraction), so that the clumps' union
