@@ -12,6 +12,7 @@
 
 #include "hilldem/bodies/clump_template.hpp"
 #include "hilldem/engine/simulation.hpp"
+#include "hilldem/labtests/clump_mix.hpp"
 #include "hilldem/labtests/gsd.hpp"
 #include "hilldem/labtests/material.hpp"
 #include "hilldem/labtests/measure_region.hpp"
@@ -76,11 +77,13 @@ struct GenesisSpec {
   // material's model and friction are not used here (packing.contact says how grains are packed).
   Class5Material grain;
   PackingSettings packing;
-  // Grains as clumps (docs/clumps.md, "Specimens of clumps"): empty for balls, else a named template
-  // (bodies/clump_shapes.hpp: sphere, elongated2, elongated3). Each grain is the template scaled so
-  // that its size by clump_size is the size drawn from the grading, turned to a uniformly random
+  // Grains as clumps (docs/clumps.md, "Specimens of clumps"): empty for balls, else named templates
+  // (bodies/clump_shapes.hpp: sphere, elongated2, ...) with the solid volume fraction each takes
+  // (check_clump_mix; one template: the list of one at 1). Each grain's template is drawn from the
+  // seed on a stream of its own (assign_clump_templates), the grain is that template scaled so that
+  // its size by clump_size is the size drawn from the grading, turned to a uniformly random
   // orientation drawn from the seed after its position.
-  std::string clump_template;
+  ClumpMix clump_mix;
   SizeMeasure clump_size = SizeMeasure::EqualVolumeDiameter;
   // Not physics: given to every Simulation made from this spec (Simulation::interrupt), and by
   // make_packed to a specimen it loads, so that a lab test stops between two cycles when it
@@ -137,8 +140,10 @@ struct Specimen {
   GrainModel packed_with = GrainModel::Linear;  // the grain-grain model of the packing contacts
   bool wet = false;
   std::vector<PhaseReport> phases;     // genesis history
-  // Grains as clumps of this named template ("" for balls), sized by clump_size.
-  std::string clump_template;
+  // Grains as clumps of these named templates at these solid volume fractions (empty for balls),
+  // sized by clump_size; clump_kind: each clump's template, an index into clump_mix, in clump order.
+  ClumpMix clump_mix;
+  std::vector<std::uint32_t> clump_kind;
   SizeMeasure clump_size = SizeMeasure::EqualVolumeDiameter;
   // The grains' sizes [m]: a ball's diameter; a clump's size by clump_size (the equal-volume
   // diameter (6V/π)^(1/3), or the enclosing diameter 2 max_k(|p_k| + r_k)), clumps first in clump order.
@@ -150,6 +155,9 @@ std::size_t grain_count(const Simulation& sim);
 // The grains' solid volume [m³]: 4/3 π r³ per ball that is not a pebble, the union volume m/ρ per
 // clump (its pebbles' overlaps counted once: the template's, docs/clumps.md).
 double solid_volume(const Simulation& sim);
+// Each template's share of the clumps' union volume [-], in the order of s.clump_mix: the mix the
+// genesis realised (its target is clump_mix's fractions, to within the largest grain's volume).
+std::vector<double> clump_mix_fractions(const Specimen& s);
 // "sizes = equal-volume diameter" or "sizes = enclosing diameter", for logs.
 const char* to_string(SizeMeasure m);
 
