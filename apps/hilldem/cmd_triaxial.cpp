@@ -112,7 +112,8 @@ std::pair<StudySettings, std::vector<CaseSpec>> build(const Options& o) {
   s.suction = o.suction;
   s.moisture_gap = o.moisture_gap;
   s.specimen_file = o.specimen;
-  s.genesis.clump_template = o.clump_template;  // validated with the rest (the known names)
+  s.genesis.clump_mix = parse_clump_mix(o.clump_template, "--clump-template");
+  check_clump_mix(s.genesis.clump_mix, "--clump-template");
   const std::string size = lower(o.clump_size);
   if (size != "equal-volume" && size != "enclosing")
     throw InputError("--clump-size must be equal-volume or enclosing, got '" + o.clump_size + "'");
@@ -154,8 +155,8 @@ int run(const Options& o) {
   const bool root = !ranks || ranks->rank() == 0;
   auto [settings, cases] = build(o);  // throws InputError (exit 2) before anything is written
   settings.genesis.ranks = ranks.get();
-  if (ranks && !settings.genesis.clump_template.empty())
-    throw InputError("--clump-template: a specimen of clumps does not run over MPI ranks yet (docs/mpi.md): run it without mpirun");
+  if (ranks && !settings.genesis.clump_mix.empty())
+    throw InputError("--clump-template: a lab specimen of clumps does not run over MPI ranks yet (docs/mpi.md): run it without mpirun");
   // The folder is this process's while it runs (io/output_folder.hpp); an unwritable one is bad input.
   const OutputLock lock = lab_output_lock(settings.output_dir, ranks.get());
   settings.genesis.interrupt = lab_stop_check(ranks.get());
@@ -179,9 +180,10 @@ int run_locked(const Options& o, const StudySettings& settings, const std::vecto
                             ? fmt::format(", each grading's scaled up to hold {} grains (--min-grains)", settings.min_grains)
                             : std::string(),
                         settings.output_dir);
-  if (log && !settings.genesis.clump_template.empty())
-    *log << fmt::format("grains: clumps of {} ({}), turned at random from the seed\n", settings.genesis.clump_template,
-                        to_string(settings.genesis.clump_size));
+  if (log && !settings.genesis.clump_mix.empty())
+    *log << fmt::format("grains: clumps of {} ({}), {}turned at random from the seed\n", clump_mix_words(settings.genesis.clump_mix),
+                        to_string(settings.genesis.clump_size),
+                        settings.genesis.clump_mix.size() > 1 ? "each grain's template drawn from the seed, " : "");
   if (o.pack_only) {
     const auto t0 = std::chrono::steady_clock::now();
     const std::clock_t c0 = std::clock();
@@ -255,7 +257,8 @@ Command add_triaxial_command(CLI::App& app) {
   cmd->add_option("--specimen", o->specimen, "start from a saved packed specimen (out/.../specimens/<grading>_packed.csv)");
   cmd->add_option("--clump-template", o->clump_template,
                   std::string("grains as clumps of this template (") + kNamedTemplates +
-                      "), each scaled to its drawn size and turned at random from the seed (docs/clumps.md); default: balls");
+                      "), or of a mix by solid volume fraction, NAME:FRACTION,... summing to 1 (elongated2:0.6,sphere:0.4); "
+                      "each scaled to its drawn size and turned at random from the seed (docs/clumps.md); default: balls");
   cmd->add_option("--clump-size", o->clump_size,
                   "what a clump's drawn size is: equal-volume (the diameter of the sphere of equal volume, the default) or "
                   "enclosing (the diameter of the smallest sphere about its centre of mass that holds it)");

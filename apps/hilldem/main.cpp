@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "openmp_wait.hpp"
 #include "hilldem/core/error.hpp"
 #ifdef HILLDEM_MPI
 #include "hilldem/parallel/mpi_world.hpp"
@@ -29,6 +30,7 @@ int run_failed(int status) { return status; }
 }  // namespace
 
 int main(int argc, char** argv) {
+  hilldem::cli::set_openmp_spin(argv);
 #ifdef HILLDEM_MPI
   hilldem::parallel::MpiSession mpi(argc, argv);
   g_rank = mpi.rank();

@@ -541,10 +541,32 @@ rows. InputError naming the file, line and value on bad input.)");
       .def_readwrite("vessel_height", &GenesisSpec::vessel_height, "Vessel height [m] (default the memo's 0.240; StudySettings' default 0.120).")
       .def_readwrite("grain", &GenesisSpec::grain, "Class5Material whose density, E and nu the grains take.")
       .def_readwrite("packing", &GenesisSpec::packing, "PackingSettings.")
-      .def_readwrite("clump_template", &GenesisSpec::clump_template,
-                     "Grains as clumps of this named template (sphere, elongated2, elongated3, ellipsoid, cube, prism, slab, "
-                     "rock; docs/clumps.md), each scaled to its drawn size and turned at random from the seed; '' (the "
-                     "default): balls.")
+      .def_property(
+          "clump_mix", [](const GenesisSpec& g) { return g.clump_mix; },
+          [](GenesisSpec& g, const py::object& v) {
+            // A list of (name, fraction) pairs or a dict {name: fraction}; checked as --clump-template is.
+            ClumpMix mix;
+            if (py::isinstance<py::dict>(v)) {
+              for (const auto& [k, f] : v.cast<py::dict>()) mix.emplace_back(k.cast<std::string>(), f.cast<double>());
+            } else {
+              mix = v.cast<ClumpMix>();
+            }
+            check_clump_mix(mix, "GenesisSpec.clump_mix");
+            g.clump_mix = std::move(mix);
+          },
+          "Grains as clumps of named templates (sphere, elongated2, elongated3, ellipsoid, cube, prism, slab, rock; "
+          "docs/clumps.md) at solid volume fractions [-]: a list of (name, fraction) tuples or a dict, the fractions in "
+          "(0, 1] summing to 1; each grain's template drawn from the seed, the grain scaled to its drawn size and turned "
+          "at random; [] (the default): balls. InputError naming the bad name or fraction.")
+      .def_property(
+          "clump_template", [](const GenesisSpec& g) { return clump_mix_text(g.clump_mix); },
+          [](GenesisSpec& g, const std::string& text) {
+            ClumpMix mix = parse_clump_mix(text, "GenesisSpec.clump_template");
+            check_clump_mix(mix, "GenesisSpec.clump_template");
+            g.clump_mix = std::move(mix);
+          },
+          "clump_mix as the CLI's --clump-template text: 'elongated2' (one template) or 'elongated2:0.6,sphere:0.4'; "
+          "'' (the default): balls.")
       .def_readwrite("clump_size", &GenesisSpec::clump_size, "SizeMeasure: what a clump's drawn size [m] is.");
   py::class_<TriaxialSettings>(lab, "TriaxialSettings", "The servo-controlled triaxial test (lab-tests.md §4).")
       .def(py::init<>(), "The header's defaults.")
@@ -631,6 +653,17 @@ genesis history. The drivers (finalize, make_wet, triaxial) change it in place: 
       .def_readonly("material", &Specimen::material, "What the assignment table holds: 'packed', 'C5b_Hill', ...")
       .def_readonly("packed_with", &Specimen::packed_with, "GrainModel of the packing contacts.")
       .def_readonly("wet", &Specimen::wet, "Whether make_wet has run [bool].")
+      .def_readonly("clump_mix", &Specimen::clump_mix, "Its clumps' templates and target solid fractions [(name, fraction)]; [] for balls.")
+      .def_property_readonly(
+          "clump_templates",
+          [](const Specimen& s) {
+            std::vector<std::string> names;
+            for (std::uint32_t k : s.clump_kind) names.push_back(s.clump_mix[k].first);
+            return names;
+          },
+          "Each clump's template name, in clump order.")
+      .def_property_readonly("clump_mix_fractions", [](const Specimen& s) { return clump_mix_fractions(s); },
+                             "Each template's realised share of the clumps' union volume [-], in clump_mix's order.")
       .def_property_readonly("grains", [](const Specimen& s) { return s.sim.balls.size(); }, "Grains [-].")
       .def_property_readonly("phases", [](const Specimen& s) { return phase_list(s.phases); },
                              "Genesis phases: [{'name', 'steps', 'seconds' [s], 'state', 'line'}].")

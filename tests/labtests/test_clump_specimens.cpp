@@ -30,7 +30,7 @@ GenesisSpec clump_spec(const std::string& name, SizeMeasure m = SizeMeasure::Equ
   GenesisSpec spec = testing::mini_spec();
   spec.vessel_radius = 0.2 * 0.085;
   spec.vessel_height = 0.2 * 0.240;
-  spec.clump_template = name;
+  spec.clump_mix = {{name, 1.0}};
   spec.clump_size = m;
   return spec;
 }
@@ -240,7 +240,7 @@ TEST(ClumpGenesis, ASmallClumpSpecimenPacksDeterministicallyAndRunsATriaxialTest
   {
     const std::filesystem::path dir = std::filesystem::temp_directory_path() / "hilldem_labtests_clump_specimen_kind";
     StudySettings bad = testing::mini_study_from_saved(dir);
-    bad.genesis.clump_template = "elongated2";
+    bad.genesis.clump_mix = {{"elongated2", 1.0}};
     try {
       validate(bad, {CaseSpec{std::string(HILLDEM_SOURCE_DIR) + "/tests/data/labtests/fine.csv", GrainModel::Hill, false}});
       FAIL() << "no error";

@@ -7,6 +7,7 @@ add_executable(hilldem_labtests_tests
   labtests/test_measure.cpp
   labtests/test_genesis.cpp
   labtests/test_clump_specimens.cpp
+  labtests/test_clump_mix.cpp
 )
 target_link_libraries(hilldem_labtests_tests PRIVATE hilldem::core GTest::gtest_main)
 target_compile_definitions(hilldem_labtests_tests PRIVATE HILLDEM_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
@@ -182,6 +183,33 @@ add_test(NAME cli.triaxial_clumps_with_a_ball_specimen_exits_2
   COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "the file's grains are balls"
           2 $<TARGET_FILE:hilldem> triaxial --clump-template elongated2 --specimen ${HILLDEM_TEST_DATA}/labtests/mini_packed.csv
             --grading ${HILLDEM_TEST_DATA}/labtests/fine.csv -o ${HILLDEM_TRIAXIAL_OUT}/clump4)
+# A mix of templates (NAME:FRACTION,...): bad fractions and names refused naming the option and the
+# range; a good one packs, says the mix and writes each clump's template into the specimen file.
+add_test(NAME cli.triaxial_clump_mix_bad_sum_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "--clump-template: the fractions must sum to 1 (within 1e-09), got 1.1" --not-stdout "cloud"
+          2 $<TARGET_FILE:hilldem> triaxial --clump-template elongated2:0.6,sphere:0.5 -o ${HILLDEM_TRIAXIAL_OUT}/clump5)
+add_test(NAME cli.triaxial_clump_mix_bad_fraction_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "--clump-template: the fraction of sphere must be in (0, 1] (of the solid volume), got 0"
+          --not-stdout "cloud"
+          2 $<TARGET_FILE:hilldem> triaxial --clump-template elongated2:1,sphere:0 -o ${HILLDEM_TRIAXIAL_OUT}/clump6)
+add_test(NAME cli.triaxial_clump_mix_unknown_name_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "--clump-template: unknown clump template 'ball'; known: sphere, elongated2" --not-stdout "cloud"
+          2 $<TARGET_FILE:hilldem> triaxial --clump-template ball:0.5,sphere:0.5 -o ${HILLDEM_TRIAXIAL_OUT}/clump7)
+add_test(NAME cli.triaxial_clump_mix_malformed_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "--clump-template: expected NAME or NAME:FRACTION,NAME:FRACTION,..." --not-stdout "cloud"
+          2 $<TARGET_FILE:hilldem> triaxial --clump-template elongated2,sphere -o ${HILLDEM_TRIAXIAL_OUT}/clump8)
+add_test(NAME cli.triaxial_clump_mix_packs
+  COMMAND bash -c "set -e; rm -rf \"$1\"; mkdir -p \"$(dirname \"$1\")\"; \"$0\" triaxial --pack-only --grading \"$2\" --scale 0.15 --seed 42 --threads 1 --jobs 1 \
+          --clump-template elongated2:0.5,sphere:0.5 -o \"$1\" > \"$1.log\"; \
+          grep -F 'grains: clumps of a mix by solid volume of elongated2 0.5, sphere 0.5' \"$1.log\"; \
+          grep -F 'clumps of a mix by solid volume of elongated2 0.5, sphere 0.5 (realised 0.' \"$1.log\"; \
+          f=\"$1/specimens/fine_hill_packed.csv\"; grep -Fx 'clump_template,elongated2:0.5,sphere:0.5' \"$f\"; \
+          grep -F 'id,template,x[m]' \"$f\"; grep -qE '^[0-9]+,sphere,' \"$f\"; grep -qE '^[0-9]+,elongated2,' \"$f\"; \
+          \"$0\" triaxial --specimen \"$f\" --grading \"$2\" --clump-template elongated2 -o \"$1/again\" 2>&1 \
+            | grep -F \"the file's grains are clumps of elongated2:0.5,sphere:0.5\""
+          $<TARGET_FILE:hilldem> ${HILLDEM_TRIAXIAL_OUT}/clump_mix ${HILLDEM_TEST_DATA}/labtests/fine.csv)
 set_tests_properties(cli.triaxial_unknown_clump_template_exits_2 cli.triaxial_clump_density_scaling_exits_2
   cli.triaxial_clump_size_without_template_exits_2 cli.triaxial_clumps_with_a_ball_specimen_exits_2
+  cli.triaxial_clump_mix_bad_sum_exits_2 cli.triaxial_clump_mix_bad_fraction_exits_2 cli.triaxial_clump_mix_unknown_name_exits_2
+  cli.triaxial_clump_mix_malformed_exits_2 cli.triaxial_clump_mix_packs
   PROPERTIES TIMEOUT 120 LABELS "cli;labtests;clumps")

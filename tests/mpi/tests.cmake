@@ -21,7 +21,11 @@ foreach(ranks 1 2 3 4)
   # Balls sliding across the sub-domains keep their rows' history: bitwise the whole run.
   add_test(NAME mpi.sliding_across_ranks_${ranks}_ranks
     COMMAND ${HILLDEM_MPIRUN} -np ${ranks} $<TARGET_FILE:hilldem_mpi_tests>)
-  set_tests_properties(mpi.bench_digest_${ranks}_ranks mpi.sliding_across_ranks_${ranks}_ranks
+  # The bench bed as clumps (pebble pairs) decomposed: one process's digest (cli.bench_pair_bed_digest_*).
+  add_test(NAME mpi.bench_pair_bed_digest_${ranks}_ranks
+    COMMAND ${HILLDEM_EXPECT_EXIT} --stdout "digest=${HILLDEM_PAIR_BED_DIGEST}" --stdout "ranks=${ranks} "
+            0 ${HILLDEM_MPIRUN} -np ${ranks} $<TARGET_FILE:hilldem> bench --steps 60 --warmup 0 --threads 1 --digest --clumps pairs)
+  set_tests_properties(mpi.bench_digest_${ranks}_ranks mpi.bench_pair_bed_digest_${ranks}_ranks mpi.sliding_across_ranks_${ranks}_ranks
     PROPERTIES TIMEOUT 300 LABELS mpi ENVIRONMENT "OMP_NUM_THREADS=1")
 endforeach()
 # Scenarios under `hilldem run` over N ranks: every checkpoint's state digest (the one after
@@ -41,8 +45,12 @@ foreach(ranks 1 2 3 4)
   add_test(NAME mpi.moving_balls_run_${ranks}_ranks
     COMMAND ${HILLDEM_MPI_SCENARIO} ${CMAKE_CURRENT_BINARY_DIR}/mpi_moving_balls_${ranks}
             ${CMAKE_CURRENT_SOURCE_DIR}/mpi/moving_balls.toml run ${ranks})
+  # Clumps thrown about a box: they migrate between the ranks with their state and pebbles.
+  add_test(NAME mpi.clumps_thrown_run_${ranks}_ranks
+    COMMAND ${HILLDEM_MPI_SCENARIO} ${CMAKE_CURRENT_BINARY_DIR}/mpi_clumps_thrown_${ranks}
+            ${CMAKE_CURRENT_SOURCE_DIR}/mpi/clumps_thrown.toml run ${ranks})
   list(APPEND HILLDEM_MPI_SCENARIO_TESTS mpi.wet_servo_run_${ranks}_ranks mpi.triaxial_servos_run_${ranks}_ranks
-       mpi.moving_balls_run_${ranks}_ranks)
+       mpi.moving_balls_run_${ranks}_ranks mpi.clumps_thrown_run_${ranks}_ranks)
 endforeach()
 # examples/assembly_27.toml (hill grains in a box of facets, the automatic time step, solve) on 2 and 4.
 foreach(ranks 2 4)
@@ -61,8 +69,12 @@ add_test(NAME mpi.checkpoint_of_4_ranks_resumes_on_2_and_1
 add_test(NAME mpi.moving_balls_checkpoint_of_4_ranks_resumes_on_2_and_1
   COMMAND ${HILLDEM_MPI_SCENARIO} ${CMAKE_CURRENT_BINARY_DIR}/mpi_moving_balls_resume
           ${CMAKE_CURRENT_SOURCE_DIR}/mpi/moving_balls.toml resume 000005 000009)
+# The thrown clumps' checkpoints from 4 ranks in flight (step 9,000) and after the set stage (step 20,000).
+add_test(NAME mpi.clumps_checkpoint_of_4_ranks_resumes_on_2_and_1
+  COMMAND ${HILLDEM_MPI_SCENARIO} ${CMAKE_CURRENT_BINARY_DIR}/mpi_clumps_thrown_resume
+          ${CMAKE_CURRENT_SOURCE_DIR}/mpi/clumps_thrown.toml resume 000004 000009)
 list(APPEND HILLDEM_MPI_SCENARIO_TESTS mpi.checkpoint_of_4_ranks_resumes_on_2_and_1
-     mpi.moving_balls_checkpoint_of_4_ranks_resumes_on_2_and_1)
+     mpi.moving_balls_checkpoint_of_4_ranks_resumes_on_2_and_1 mpi.clumps_checkpoint_of_4_ranks_resumes_on_2_and_1)
 string(REPLACE ";" " " HILLDEM_MPIRUN_LINE "${HILLDEM_MPIRUN}")
 set_tests_properties(${HILLDEM_MPI_SCENARIO_TESTS} PROPERTIES TIMEOUT 300 LABELS mpi
   ENVIRONMENT "OMP_NUM_THREADS=1;MPIRUN=${HILLDEM_MPIRUN_LINE}")

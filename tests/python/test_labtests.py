@@ -125,9 +125,41 @@ def test_clump_genesis_from_python_is_the_clis(cli, source_dir, tmp_path):
     mine = tmp_path / "mine.csv"
     s.save(mine, spec.packing)
     assert mine.read_text() == (tmp_path / "specimens" / "fine_hill_packed.csv").read_text()
-    spec.clump_template = "dodecahedron"
     with pytest.raises(hilldem.InputError, match="unknown clump template 'dodecahedron'"):
-        lab.pack_specimen(spec)
+        spec.clump_template = "dodecahedron"  # refused when set, as --clump-template is before any work
+
+
+def test_clump_mix_from_python_is_the_clis(cli, source_dir, tmp_path):
+    """GenesisSpec.clump_mix: a mix of templates by solid volume, as a list of tuples or a dict; the CLI's
+    --clump-template NAME:FRACTION,... file to the byte, each clump's template in it."""
+    _, fine = mini_files(source_dir)
+    out = cli("triaxial", "--pack-only", "--grading", fine, "--scale", 0.15, "--seed", 42, "--threads", 1, "--clump-template",
+              "elongated2:0.5,sphere:0.5", "-o", tmp_path)
+    assert "grains: clumps of a mix by solid volume of elongated2 0.5, sphere 0.5" in out.stdout
+    spec = lab.GenesisSpec()
+    spec.grading = lab.grading(str(fine))
+    spec.vessel_radius, spec.vessel_height = 0.085 * 0.15, 0.240 * 0.15
+    spec.packing.seed = 42
+    spec.clump_mix = [("elongated2", 0.5), ("sphere", 0.5)]
+    assert spec.clump_template == "elongated2:0.5,sphere:0.5"
+    s = lab.pack_specimen(spec)
+    mine = tmp_path / "mine.csv"
+    s.save(mine, spec.packing)
+    assert mine.read_text() == (tmp_path / "specimens" / "fine_hill_packed.csv").read_text()
+    assert s.clump_mix == [("elongated2", 0.5), ("sphere", 0.5)]
+    assert sorted(set(s.clump_templates)) == ["elongated2", "sphere"]
+    assert sum(s.clump_mix_fractions) == pytest.approx(1.0, abs=1e-12)
+    back, _ = lab.load_specimen(mine)
+    assert back.clump_templates == s.clump_templates and back.clump_mix_fractions == s.clump_mix_fractions
+    spec.clump_mix = {"sphere": 0.25, "elongated2": 0.75}  # a dict: its order
+    assert spec.clump_mix == [("sphere", 0.25), ("elongated2", 0.75)]
+    with pytest.raises(hilldem.InputError, match=r"GenesisSpec.clump_mix: the fractions must sum to 1 \(within 1e-09\), got 1.1"):
+        spec.clump_mix = [("elongated2", 0.5), ("sphere", 0.6)]
+    with pytest.raises(hilldem.InputError, match=r"the fraction of sphere must be in \(0, 1\]"):
+        spec.clump_mix = {"elongated2": 1.0, "sphere": 0.0}
+    with pytest.raises(hilldem.InputError, match="unknown clump template 'ball'; known: sphere, elongated2"):
+        spec.clump_template = "ball:0.5,sphere:0.5"
+    assert spec.clump_mix == [("sphere", 0.25), ("elongated2", 0.75)]  # a refused mix leaves the last one
 
 
 def test_gradings(source_dir):

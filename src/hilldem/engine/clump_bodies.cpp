@@ -43,12 +43,14 @@ std::vector<std::uint32_t> ClumpBodies::clump_of_balls(std::size_t n) const {
 }
 
 void ClumpBodies::place_pebbles(BallStore& balls) const {
-  for (std::size_t k = 0; k < pebbles.size(); ++k) {
-    const std::uint32_t b = ball[k];
-    balls.position[b] = pebble_position(state, pebbles, k);
-    balls.velocity[b] = pebble_velocity(state, pebbles, k);
-    balls.spin[b] = state.spin[pebbles.clump[k]];
-  }
+  for (std::size_t k = 0; k < pebbles.size(); ++k) place_pebble(balls, k);
+}
+
+void ClumpBodies::place_pebble(BallStore& balls, std::size_t k) const {
+  const std::uint32_t b = ball[k];
+  balls.position[b] = pebble_position(state, pebbles, k);
+  balls.velocity[b] = pebble_velocity(state, pebbles, k);
+  balls.spin[b] = state.spin[pebbles.clump[k]];
 }
 
 void ClumpBodies::loads(const BallStore& balls, const motion::ContactSums* sums) {

@@ -51,9 +51,14 @@ struct ClumpBodies {
   // clumps' eight, their groups, then the pebbles' four. kColumnNames: their names, in this order.
   template <class F>
   void for_each_column(F&& f) {
+    for_each_clump_column(f);
+    f(pebbles.clump); f(pebbles.body_position); f(pebbles.radius); f(ball);
+  }
+  // The columns with one entry per clump (the first nine: what a clump is, without its pebbles).
+  template <class F>
+  void for_each_clump_column(F&& f) {
     f(state.position); f(state.velocity); f(state.orientation); f(state.spin); f(state.body_momentum);
     f(state.mass); f(state.principal_inertia); f(state.fixity); f(groups);
-    f(pebbles.clump); f(pebbles.body_position); f(pebbles.radius); f(ball);
   }
   static constexpr const char* kColumnNames[] = {"position", "velocity", "orientation", "spin", "body_momentum",
                                                  "mass", "principal_inertia", "fixity", "groups", "pebble_clump",
@@ -66,6 +71,8 @@ struct ClumpBodies {
   std::vector<std::uint32_t> clump_of_balls(std::size_t n) const;
   // The pebbles' positions, velocities and spins [m, m/s, rad/s] in the balls' columns, from the clumps.
   void place_pebbles(BallStore& balls) const;
+  // The same for pebble k.
+  void place_pebble(BallStore& balls, std::size_t k) const;
   // The clumps' law of motion over Δt [s] with the loads at t on their pebbles: contact sums (the
   // force pass's, or the columns when null) plus the pebbles' applied loads, summed into force and
   // torque about each centre of mass (sum_pebble_loads), then step_clump; then place_pebbles.

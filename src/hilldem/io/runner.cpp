@@ -1031,8 +1031,13 @@ void restore_scenario(const CheckpointReader& r, Scenario& sc) {
   auto mismatch = [&](const std::string& what) {
     throw InputError(r.source() + ": the saved state does not match its scenario (" + what + ")");
   };
-  if (restored.balls.size() != fresh.balls.size())
-    mismatch(fmt::format("{} balls saved, the scenario has {}", restored.balls.size(), fresh.balls.size()));
+  // (The balls, then the clumps' pebbles, in the order build_simulation adds them.)
+  std::size_t pebbles = 0;
+  for (const SimulationDescription::Clump& c : fresh.clumps) pebbles += fresh.clump_templates[c.tmpl].pebbles.size();
+  if (restored.balls.size() != fresh.balls.size() + pebbles)
+    mismatch(fmt::format("{} balls saved, the scenario has {} and {} pebbles", restored.balls.size(), fresh.balls.size(), pebbles));
+  if (restored.clumps.size() != fresh.clumps.size())
+    mismatch(fmt::format("{} clumps saved, the scenario has {}", restored.clumps.size(), fresh.clumps.size()));
   for (std::size_t i = 0; i < fresh.balls.size(); ++i)
     if (restored.balls.id[i] != fresh.balls[i].id) mismatch(fmt::format("ball {} is saved at index {}", restored.balls.id[i], i));
   if (restored.walls.size() != fresh.walls.size())

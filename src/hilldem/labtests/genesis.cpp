@@ -101,7 +101,7 @@ void validate(const GenesisSpec& s) {
   check_range(e.wall_speed_limit > 0 && std::isfinite(e.wall_speed_limit), "wall speed limit [m/s]", e.wall_speed_limit, "> 0");
   check_range(e.porosity_change > 0 && e.porosity_change < 1, "porosity change per 1,000 steps", e.porosity_change, "in (0, 1)");
   check_range(e.porosity_window >= 1000, "porosity window [steps]", static_cast<double>(e.porosity_window), ">= 1000");
-  if (!s.clump_template.empty()) named_template(s.clump_template, s.grain.density);  // throws naming the known ones
+  check_clump_mix(s.clump_mix, "clump templates");  // names the known templates, the fractions' range and sum
   double d_max = 0.0;
   for (const GradingBin& b : s.grading.bins) d_max = std::max(d_max, b.d_upper * s.d_mult);
   if (d_max >= std::min(2 * s.vessel_radius, s.vessel_height))
@@ -254,9 +254,10 @@ bool is_root(const Specimen& s) { return !s.ranks || s.ranks->rank() == 0; }
 
 void attach_to_ranks(Specimen& s, double reach) {
   if (!s.ranks || s.sim.domain) return;
-  // (Domain::gather, which the readings use, carries no clumps yet: refused on one rank too.)
+  // The drivers' readings over ranks (a row counted by the owner of its first ball, the velocity cap
+  // of the cloud relaxation on ghost clumps) are made and tested for balls only: refused on one rank too.
   if (!s.sim.clumps.empty())
-    throw InputError("a specimen of clumps does not run over MPI ranks yet (docs/mpi.md): run it without mpirun");
+    throw InputError("a lab specimen of clumps does not run over MPI ranks yet (docs/mpi.md): run it without mpirun");
   // Taken here, on the whole run: a rank's balls (owned and ghosts) are not the grains.
   s.whole_grains = grain_count(s.sim);
   s.whole_solid = solid_volume(s.sim);
@@ -411,29 +412,39 @@ Specimen make_cloud(const GenesisSpec& spec) {
   Rng rng(p.seed);
   const double volume = std::numbers::pi * R * R * H;
   const Class5Material& grain_defaults = spec.grain;  // density, E, ν until finalization sets the material
-  const bool clumps = !spec.clump_template.empty();
-  s.clump_template = spec.clump_template;
+  const bool clumps = !spec.clump_mix.empty();
+  s.clump_mix = spec.clump_mix;
   s.clump_size = spec.clump_size;
-  ClumpTemplate unit;
-  // A clump of size d by the chosen measure has volume f π d³/6: f = 1 for the equal-volume diameter,
-  // below 1 for the enclosing one. The grading is sampled for the solid volume (1 − n_c) V_vessel / f
-  // in spheres of the drawn sizes, so that the clumps' union volumes fill (1 − n_c) V_vessel.
-  double volume_factor = 1.0;
-  if (clumps) {
-    unit = named_template(spec.clump_template, grain_defaults.density);
-    const double d = unit.size(spec.clump_size);
-    volume_factor = unit.volume / (std::numbers::pi * d * d * d / 6.0);
+  // Per template: its unit (as named_template makes it), its volume factor f and its enclosing diameter per
+  // size. A clump of size d by the chosen measure has volume f π d³/6: f = 1 for the equal-volume
+  // diameter, below 1 for the enclosing one. The grading is sampled for the sphere volume
+  // Σ_t (1 − n_c) V_vessel w_t / f_t (w_t the template's solid fraction), so that the clumps' union
+  // volumes fill (1 − n_c) V_vessel; with one template, (1 − n_c) V_vessel / f.
+  std::vector<ClumpTemplate> unit;
+  std::vector<double> volume_factor, enclosing;
+  const double solid = (1.0 - p.cloud_porosity) * volume;
+  double sphere_volume = clumps ? 0.0 : solid;
+  for (const auto& [name, fraction] : spec.clump_mix) {
+    unit.push_back(named_template(name, grain_defaults.density));
+    const double d = unit.back().size(spec.clump_size);
+    volume_factor.push_back(unit.back().volume / (std::numbers::pi * d * d * d / 6.0));
+    // A clump is placed as the sphere that encloses it (about its centre of mass): its enclosing
+    // radius is d/2 × (enclosing diameter / size) of the unit template.
+    enclosing.push_back(unit.back().size(SizeMeasure::EnclosingDiameter) / d);
+    sphere_volume += solid * fraction / volume_factor.back();
   }
-  const GrainSample sample =
-      sample_grains(spec.grading, spec.d_mult, (1.0 - p.cloud_porosity) * volume / volume_factor, rng);
+  const GrainSample sample = sample_grains(spec.grading, spec.d_mult, sphere_volume, rng);
+  // Each grain's template, from a stream of its own: the sizes above and the positions and
+  // orientations below are the seed's draws whatever the mix.
+  const std::vector<std::uint32_t> kind =
+      clumps ? assign_clump_templates(sample.diameters, spec.clump_mix, volume_factor, p.seed) : std::vector<std::uint32_t>{};
   std::vector<std::size_t> order(sample.diameters.size());
   std::iota(order.begin(), order.end(), std::size_t{0});
   std::stable_sort(order.begin(), order.end(),
                    [&](std::size_t a, std::size_t b) { return sample.diameters[a] > sample.diameters[b]; });
-  // A clump is placed as the sphere that encloses it (about its centre of mass): its enclosing radius
-  // is d/2 × (enclosing diameter / size) of the unit template.
-  const double enclosing = clumps ? unit.size(SizeMeasure::EnclosingDiameter) / unit.size(spec.clump_size) : 1.0;
-  const double d_max = order.empty() ? 0.0 : sample.diameters[order.front()] * enclosing;
+  auto reach = [&](std::size_t i) { return clumps ? enclosing[kind[i]] : 1.0; };  // enclosing diameter per size
+  double d_max = 0.0;
+  for (std::size_t i : order) d_max = std::max(d_max, sample.diameters[i] * reach(i));
   PlacementGrid grid(R, H, std::max(d_max, 1e-9));
   std::vector<Vec3> pos;
   std::vector<double> rad;
@@ -441,7 +452,7 @@ Specimen make_cloud(const GenesisSpec& spec) {
   rad.reserve(order.size());
   std::int64_t next_id = 1;
   for (std::size_t i : order) {
-    const double r = 0.5 * sample.diameters[i] * enclosing;
+    const double r = 0.5 * sample.diameters[i] * reach(i);
     Vec3 best;
     double best_overlap = std::numeric_limits<double>::infinity();
     for (int t = 0; t < std::max(1, p.placement_tries); ++t) {
@@ -460,7 +471,7 @@ Specimen make_cloud(const GenesisSpec& spec) {
       const double u1 = rng.uniform(), u2 = 2.0 * std::numbers::pi * rng.uniform(), u3 = 2.0 * std::numbers::pi * rng.uniform();
       const Quat q{std::sqrt(1.0 - u1) * std::sin(u2), std::sqrt(1.0 - u1) * std::cos(u2), std::sqrt(u1) * std::sin(u3),
                    std::sqrt(u1) * std::cos(u3)};
-      const ClumpTemplate t = unit.scaled(sample.diameters[i], spec.clump_size);
+      const ClumpTemplate t = unit[kind[i]].scaled(sample.diameters[i], spec.clump_size);
       ClumpInit c;
       c.first_ball_id = next_id;
       c.position = best;
@@ -469,6 +480,7 @@ Specimen make_cloud(const GenesisSpec& spec) {
       c.pois_ratio = grain_defaults.pois_ratio;
       c.groups = grain_bit;
       sim.clumps.add(sim.balls, t, c);
+      s.clump_kind.push_back(kind[i]);
       next_id += static_cast<std::int64_t>(t.pebbles.size());
       continue;
     }
@@ -613,6 +625,27 @@ PhaseReport servo_equilibrium(Specimen& s, const EquilibriumSettings& e, const s
   return r;
 }
 
+std::vector<double> clump_mix_fractions(const Specimen& s) {
+  std::vector<double> v(s.clump_mix.size(), 0.0);
+  const std::vector<double> volume = clump_volumes(s.sim);
+  if (s.clump_kind.size() != volume.size()) throw InputError("the specimen's clumps and their templates do not match");
+  double total = 0.0;
+  for (std::size_t i = 0; i < volume.size(); ++i) v[s.clump_kind[i]] += volume[i], total += volume[i];
+  for (double& x : v) x = total > 0.0 ? x / total : 0.0;
+  return v;
+}
+
+namespace {
+// " (realised 0.603, 0.397)" for a mix: the solid fractions drawn; "" for one template.
+std::string realised_text(const Specimen& s) {
+  if (s.clump_mix.size() < 2) return {};
+  std::string out = " (realised";
+  const std::vector<double> f = clump_mix_fractions(s);
+  for (std::size_t t = 0; t < f.size(); ++t) out += fmt::format("{} {:.3f}", t ? "," : "", f[t]);
+  return out + ")";
+}
+}  // namespace
+
 Specimen pack_specimen(const GenesisSpec& spec, std::ostream* log) {
   const auto t0 = std::chrono::steady_clock::now();
   Specimen s = make_cloud(spec);
@@ -620,10 +653,10 @@ Specimen pack_specimen(const GenesisSpec& spec, std::ostream* log) {
     *log << fmt::format("cloud: {} grains{} of {} at porosity {:.3f} in a {:.0f} mm x {:.0f} mm vessel (seed {}, {:.1f} s); "
                         "packing contacts {} with friction {:g}; converged when {}\n",
                         grain_count(s.sim),
-                        s.clump_template.empty()
+                        s.clump_mix.empty()
                             ? std::string()
-                            : fmt::format(" (clumps of {}, {} pebbles, {})", s.clump_template, s.sim.clumps.pebbles.size(),
-                                          to_string(s.clump_size)),
+                            : fmt::format(" (clumps of {}{}, {} pebbles, {})", clump_mix_words(s.clump_mix),
+                                          realised_text(s), s.sim.clumps.pebbles.size(), to_string(s.clump_size)),
                         spec.grading.name, measure(s).porosity, 2e3 * spec.vessel_radius,
                         1e3 * spec.vessel_height, spec.packing.seed, seconds_since(t0), to_string(spec.packing.contact.model),
                         spec.packing.contact.fric, criterion_text(spec.packing.equilibrium));

@@ -14,6 +14,7 @@
 
 #include "hilldem/bodies/clump_template.hpp"
 #include "hilldem/engine/simulation.hpp"
+#include "hilldem/labtests/clump_mix.hpp"
 #include "hilldem/labtests/gsd.hpp"
 #include "hilldem/labtests/material.hpp"
 #include "hilldem/labtests/measure_region.hpp"
@@ -80,11 +81,13 @@ struct GenesisSpec {
   // material's model and friction are not used here (packing.contact says how grains are packed).
   Class5Material grain;
   PackingSettings packing;
-  // Grains as clumps (docs/clumps.md, "Specimens of clumps"): empty for balls, else a named template
-  // (bodies/clump_shapes.hpp: sphere, elongated2, elongated3). Each grain is the template scaled so
-  // that its size by clump_size is the size drawn from the grading, turned to a uniformly random
+  // Grains as clumps (docs/clumps.md, "Specimens of clumps"): empty for balls, else named templates
+  // (bodies/clump_shapes.hpp: sphere, elongated2, ...) with the solid volume fraction each takes
+  // (check_clump_mix; one template: the list of one at 1). Each grain's template is drawn from the
+  // seed on a stream of its own (assign_clump_templates), the grain is that template scaled so that
+  // its size by clump_size is the size drawn from the grading, turned to a uniformly random
   // orientation drawn from the seed after its position.
-  std::string clump_template;
+  ClumpMix clump_mix;
   SizeMeasure clump_size = SizeMeasure::EqualVolumeDiameter;
   // Not physics: given to every Simulation made from this spec (Simulation::interrupt), and by
   // make_packed to a specimen it loads, so that a lab test stops between two cycles when it
@@ -144,8 +147,10 @@ struct Specimen {
   GrainModel packed_with = GrainModel::Linear;  // the grain-grain model of the packing contacts
   bool wet = false;
   std::vector<PhaseReport> phases;     // genesis history
-  // Grains as clumps of this named template ("" for balls), sized by clump_size.
-  std::string clump_template;
+  // Grains as clumps of these named templates at these solid volume fractions (empty for balls),
+  // sized by clump_size; clump_kind: each clump's template, an index into clump_mix, in clump order.
+  ClumpMix clump_mix;
+  std::vector<std::uint32_t> clump_kind;
   SizeMeasure clump_size = SizeMeasure::EqualVolumeDiameter;
   // The grains' sizes [m]: a ball's diameter; a clump's size by clump_size (the equal-volume
   // diameter (6V/π)^(1/3), or the enclosing diameter 2 max_k(|p_k| + r_k)), clumps first in clump order.
@@ -167,7 +172,7 @@ bool is_root(const Specimen& s);
 // Make s.sim, the whole run on every rank (the same bits everywhere), this rank's part of it: its
 // balls and ghosts to `reach` [m] beyond their surfaces (make_wet's gap when the specimen is to be
 // wetted). Nothing when s.ranks is null or s is attached already. InputError for a specimen of
-// clumps (not decomposed yet).
+// clumps (the drivers' readings over ranks are made for balls only).
 void attach_to_ranks(Specimen& s, double reach);
 // Let s go (it keeps this rank's part). Nothing when not attached.
 void detach_from_ranks(Specimen& s);
@@ -212,6 +217,9 @@ std::size_t grain_count(const Simulation& sim);
 // The grains' solid volume [m³]: 4/3 π r³ per ball that is not a pebble, the union volume m/ρ per
 // clump (its pebbles' overlaps counted once: the template's, docs/clumps.md).
 double solid_volume(const Simulation& sim);
+// Each template's share of the clumps' union volume [-], in the order of s.clump_mix: the mix the
+// genesis realised (its target is clump_mix's fractions, to within the largest grain's volume).
+std::vector<double> clump_mix_fractions(const Specimen& s);
 // "sizes = equal-volume diameter" or "sizes = enclosing diameter", for logs.
 const char* to_string(SizeMeasure m);
 

@@ -93,23 +93,27 @@ std::string packed_specimen_text(const Specimen& s, const PackingSettings& p) {
   out += fmt::format("packing_fric,{}\n", p.contact.fric);
   out += fmt::format("wall_emod[Pa],{}\n", p.walls.emod);
   out += fmt::format("wall_kratio,{}\n", p.walls.kratio);
-  if (!s.clump_template.empty()) {
-    // A clump row: its first pebble's ball id (the others follow), centre of mass, orientation (the
-    // principal frame's, a unit quaternion), the factor its unit template (pebbles of radius 1) is
-    // scaled by, and its pebbles' properties. Every number is written to round trip exactly.
+  if (!s.clump_mix.empty()) {
+    // The mix (clump_mix_text: a template's name, or NAME:FRACTION,... with the fractions genesis
+    // aimed at), then a clump row: its first pebble's ball id (the others follow), its template,
+    // centre of mass, orientation (the principal frame's, a unit quaternion), the factor its unit
+    // template (pebbles of radius 1) is scaled by, and its pebbles' properties. Every number is
+    // written to round trip exactly.
     const ClumpBodies& c = sim.clumps;
     if (grain_count(sim) != c.size()) throw InputError("a specimen of clumps and balls together cannot be saved");
-    out += fmt::format("clump_template,{}\n", s.clump_template);
+    if (s.clump_kind.size() != c.size()) throw InputError("the specimen's clumps and their templates do not match");
+    out += fmt::format("clump_template,{}\n", clump_mix_text(s.clump_mix));
     out += fmt::format("clump_size,{}\n", s.clump_size == SizeMeasure::EnclosingDiameter ? "enclosing" : "equal-volume");
     out += fmt::format("grains,{}\n", c.size());
-    out += "id,x[m],y[m],z[m],qw,qx,qy,qz,scale[m],density[kg/m3],young_mod[Pa],pois_ratio[-]\n";
+    out += "id,template,x[m],y[m],z[m],qw,qx,qy,qz,scale[m],density[kg/m3],young_mod[Pa],pois_ratio[-]\n";
     std::vector<std::size_t> first(c.size(), c.pebbles.size());
     for (std::size_t k = c.pebbles.size(); k-- > 0;) first[c.pebbles.clump[k]] = k;
     for (std::size_t i = 0; i < c.size(); ++i) {
       const std::uint32_t b = c.ball[first[i]];
       const Vec3& x = c.state.position[i];
       const Quat& q = c.state.orientation[i];
-      out += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{}\n", sim.balls.id[b], x.x, x.y, x.z, q.w, q.x, q.y, q.z,
+      out += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{}\n", sim.balls.id[b], s.clump_mix[s.clump_kind[i]].first, x.x, x.y,
+                         x.z, q.w, q.x, q.y, q.z,
                          c.pebbles.radius[first[i]], sim.balls.density[b], sim.balls.young_mod[b], sim.balls.pois_ratio[b]);
     }
     return out;
@@ -145,9 +149,12 @@ Specimen parse_packed_specimen(const std::string& text, const std::string& sourc
     double v[11];
     int line;
     std::size_t body;
+    std::uint32_t kind;  // a clump's template: its index in the mix
   };
-  // A clump file has its template's name before the table (clump_template) and clump rows.
-  bool clump_file = false;
+  // A clump file has its mix before the table (clump_template) and clump rows, each naming its
+  // template (files written before mixes have no template column: every clump is the one template's).
+  bool clump_file = false, template_column = false;
+  ClumpMix mix;
   std::vector<Row> rows;
   while (std::getline(in, line)) {
     ++lineno;
@@ -163,20 +170,44 @@ Specimen parse_packed_specimen(const std::string& text, const std::string& sourc
       if (cells.size() >= 1 && cells[0] == "id") {
         header = true;
         clump_file = keys.count("clump_template") > 0;
-        if (clump_file && cells.size() != 12)
-          throw fail(lineno, "expected the header id,x[m],y[m],z[m],qw,qx,qy,qz,scale[m],density[kg/m3],young_mod[Pa],pois_ratio[-]");
+        if (clump_file) {
+          const auto& [text, at] = keys["clump_template"];
+          try {
+            mix = parse_clump_mix(text, "clump_template");
+            check_clump_mix(mix, "clump_template");
+          } catch (const InputError& e) {
+            throw fail(at, e.what());
+          }
+          if (mix.empty()) throw fail(at, "clump_template names no template");
+          template_column = cells.size() == 13 && cells[1] == "template";
+          if (!template_column && !(cells.size() == 12 && mix.size() == 1))
+            throw fail(lineno, "expected the header id,template,x[m],y[m],z[m],qw,qx,qy,qz,scale[m],density[kg/m3],young_mod[Pa],"
+                               "pois_ratio[-]");
+        }
         if (!clump_file && cells.size() != 8)
           throw fail(lineno, "expected the header id,x[m],y[m],z[m],radius[m],density[kg/m3],young_mod[Pa],pois_ratio[-]");
         continue;
       }
       if (cells.size() < 2) throw fail(lineno, "expected `key,value`, got '" + line + "'");
       if (keys.count(cells[0])) throw fail(lineno, "duplicate key '" + cells[0] + "'");
-      keys[cells[0]] = {cells.size() == 3 && cells[0] == "format" ? cells[1] + "," + cells[2] : cells[1], lineno};
+      // The value is the rest of the line (format's is "hilldem-specimen,1"; a mix's has commas).
+      std::string value = cells[1];
+      for (std::size_t k = 2; k < cells.size(); ++k) value += "," + cells[k];
+      keys[cells[0]] = {value, lineno};
       continue;
     }
     const std::size_t columns = clump_file ? 12 : 8;
-    if (cells.size() != columns) throw fail(lineno, fmt::format("expected {} values, got {}", columns, cells.size()));
+    if (cells.size() != columns + template_column)
+      throw fail(lineno, fmt::format("expected {} values, got {}", columns + template_column, cells.size()));
     Row r{};
+    if (template_column) {
+      const auto it = std::find_if(mix.begin(), mix.end(), [&](const auto& m) { return m.first == cells[1]; });
+      if (it == mix.end())
+        throw fail(lineno, fmt::format("clump {}: template '{}' is not in the file's clump_template ({})", cells[0], cells[1],
+                                       clump_mix_text(mix)));
+      r.kind = static_cast<std::uint32_t>(it - mix.begin());
+      cells.erase(cells.begin() + 1);
+    }
     r.line = lineno;
     r.body = rows.size();
     char* end = nullptr;
@@ -268,16 +299,10 @@ Specimen parse_packed_specimen(const std::string& text, const std::string& sourc
   // Each grain's pebbles or ball as (centre, radius) rows, checked against the vessel and each other.
   std::vector<Row> spheres;
   if (clump_file) {
-    const auto [name, at] = get("clump_template");
     const auto [size, size_at] = get("clump_size");
     if (size == "enclosing") s.clump_size = SizeMeasure::EnclosingDiameter;
     else if (size != "equal-volume") throw fail(size_at, "clump_size must be equal-volume or enclosing, got '" + size + "'");
-    try {
-      named_template(name, 1000.0);
-    } catch (const InputError& e) {
-      throw fail(at, e.what());
-    }
-    s.clump_template = name;
+    s.clump_mix = mix;
   }
   for (const Row& r : rows) {
     if (!clump_file) {
@@ -286,7 +311,7 @@ Specimen parse_packed_specimen(const std::string& text, const std::string& sourc
     }
     // The clump as saved: its unit template scaled by `scale` (bitwise the genesis's: the unit's
     // pebble radius is 1), its orientation and centre written over those add() computes.
-    const ClumpTemplate t = named_template(s.clump_template, r.v[8]).scaled_by(r.v[7]);
+    const ClumpTemplate t = named_template(s.clump_mix[r.kind].first, r.v[8]).scaled_by(r.v[7]);
     for (std::size_t k = 0; k < t.pebbles.size(); ++k)
       if (sim.balls.find(r.id + static_cast<std::int64_t>(k)) >= 0) throw fail(r.line, fmt::format("duplicate ball id {}", r.id + k));
     ClumpInit c;
@@ -296,6 +321,7 @@ Specimen parse_packed_specimen(const std::string& text, const std::string& sourc
     c.pois_ratio = r.v[10];
     c.groups = grain_bit;
     const std::size_t i = sim.clumps.add(sim.balls, t, c);
+    s.clump_kind.push_back(r.kind);
     sim.clumps.state.orientation[i] = Quat{r.v[3], r.v[4], r.v[5], r.v[6]};
     for (std::size_t k = 0; k < sim.clumps.pebbles.size(); ++k) {
       if (sim.clumps.pebbles.clump[k] != i) continue;

@@ -4,9 +4,11 @@
 // with the default γ_h = 0), so a loaded specimen is the saved one: finalization, wetting and tests
 // can start from it without repacking. The file says which model packed it (`packing_model`;
 // files without that key were packed with linear contacts). A specimen of clumps names its template
-// (`clump_template`) and size measure (`clump_size`) and has one row per clump: its first pebble's
-// ball id, centre of mass, orientation quaternion, scale of the unit template and pebble properties;
-// it loads bitwise (centres, orientations, pebbles) as saved.
+// or mix (`clump_template`: clump_mix_text) and size measure (`clump_size`) and has one row per
+// clump: its first pebble's ball id, its template, centre of mass, orientation quaternion, scale of
+// the unit template and pebble properties; it loads bitwise (centres, orientations, pebbles, each
+// clump's template) as saved. Files of one template without the template column (written before
+// mixes) load as that template's.
 #pragma once
 
 #include <string>

@@ -115,20 +115,20 @@ void validate(const StudySettings& s, const std::vector<CaseSpec>& cases) {
       !(m.linear_kratio > 0) || !(m.damp_con >= 0 && m.damp_con < 1) || !(m.density > 0))
     throw InputError("material properties out of range");
   if (s.jobs < 0 || s.jobs > 1024) throw InputError(fmt::format("--jobs must be in [0, 1024], got {}", s.jobs));
-  if (!s.genesis.clump_template.empty() && s.triaxial.density_scaling > 0)
+  if (!s.genesis.clump_mix.empty() && s.triaxial.density_scaling > 0)
     throw InputError("density scaling does not apply to clumps (docs/clumps.md, Limits): give --density-scaling 0 with "
                      "--clump-template");
   if (!s.specimen_file.empty()) {
     // Parse it now: a bad file stops before any work.
     const Specimen sp = load_packed_specimen(s.specimen_file);
-    const std::string& want = s.genesis.clump_template;
-    if (!want.empty() && sp.clump_template != want)
-      throw InputError(fmt::format("--clump-template {} and --specimen {}: the file's grains are {}", want, s.specimen_file,
-                                   sp.clump_template.empty() ? "balls" : "clumps of " + sp.clump_template));
-    if (!sp.clump_template.empty() && s.triaxial.density_scaling > 0)
+    const ClumpMix& want = s.genesis.clump_mix;
+    if (!want.empty() && sp.clump_mix != want)
+      throw InputError(fmt::format("--clump-template {} and --specimen {}: the file's grains are {}", clump_mix_text(want),
+                                   s.specimen_file, sp.clump_mix.empty() ? "balls" : "clumps of " + clump_mix_text(sp.clump_mix)));
+    if (!sp.clump_mix.empty() && s.triaxial.density_scaling > 0)
       throw InputError(fmt::format("density scaling does not apply to clumps (docs/clumps.md, Limits): the specimen {} has clumps "
                                    "of {}",
-                                   s.specimen_file, sp.clump_template));
+                                   s.specimen_file, clump_mix_text(sp.clump_mix)));
     for (const CaseSpec& c : cases)
       if (c.grading != cases.front().grading)
         throw InputError("--specimen gives one packed specimen: all cases must use its grading");
@@ -513,9 +513,9 @@ PackedResult make_packed(const StudySettings& settings, const std::string& gradi
     if (log)
       *log << fmt::format("specimen {}: {} grains of {} packed at {:g} kPa (seed {})\n", settings.specimen_file,
                           grain_count(p.specimen.sim), p.specimen.grading, p.specimen.pressure / 1e3, p.specimen.seed);
-    if (log && !p.specimen.clump_template.empty())
+    if (log && !p.specimen.clump_mix.empty())
       *log << fmt::format("specimen {}: grains are clumps of {} ({} pebbles, {})\n", settings.specimen_file,
-                          p.specimen.clump_template, p.specimen.sim.clumps.pebbles.size(), to_string(p.specimen.clump_size));
+                          clump_mix_words(p.specimen.clump_mix), p.specimen.sim.clumps.pebbles.size(), to_string(p.specimen.clump_size));
     if (log)
       *log << fmt::format("specimen {}: packed with {} contacts\n", settings.specimen_file, to_string(p.specimen.packed_with));
     if (p.specimen.grading != grading.name && log)
@@ -797,7 +797,7 @@ StudyResult run_study(const StudySettings& settings, const std::vector<CaseSpec>
     r.grading = p.report;
     r.packed = p.state;
     r.packed_with = p.specimen.packed_with;
-    r.clump_template = p.specimen.clump_template;
+    r.clump_template = clump_mix_text(p.specimen.clump_mix);
     r.packing_file = p.file;
     Specimen s = p.specimen;  // a copy: every case starts from the same packed state
     // Over ranks this case's part of it; the ghosts cover make_wet's gap.

@@ -88,7 +88,7 @@ struct CaseResult {
   double confinement = 0.0;             // σ_c of its test [Pa]
   GradingReport grading;
   GrainModel packed_with = GrainModel::Linear;  // grain-grain model of the packing it started from
-  std::string clump_template;           // its grains' clump template ("" for balls; docs/clumps.md)
+  std::string clump_template;           // its grains' clump template or mix, clump_mix_text ("" for balls; docs/clumps.md)
   SpecimenState packed;                 // after packing (frictionless)
   SpecimenState initial;                // after finalization (and wetting): the test's start
   std::vector<PhaseReport> phases;      // genesis phases of this case (packing shared by the cases of a grading and packing model)

@@ -103,7 +103,7 @@ Received all_to_all(MPI_Comm comm, const std::vector<Buffer>& out, std::uint64_t
 // The local index of global index g among the sorted `global`.
 std::uint32_t local_of(const std::vector<std::uint32_t>& global, std::uint32_t g) {
   const auto it = std::lower_bound(global.begin(), global.end(), g);
-  if (it == global.end() || *it != g) throw std::runtime_error("domain exchange: a row's ball did not arrive");
+  if (it == global.end() || *it != g) throw std::runtime_error("domain exchange: the ball of a row or a pebble did not arrive");
   return static_cast<std::uint32_t>(it - global.begin());
 }
 
@@ -143,13 +143,107 @@ ContactStore sort_rows(ContactStore& rows, const std::vector<std::uint32_t>* glo
   return sorted;
 }
 
+// Whether `in` is at a marker (a global index of UINT32_MAX, which no ball or clump has), read past it if so.
+bool at_marker(Reader& in) {
+  Reader peek = in;
+  if (peek.get<std::uint32_t>() != UINT32_MAX) return false;
+  in = peek;
+  return true;
+}
+
+// Clumps in arrival order: their columns, and their pebbles', each pebble's `clump` the arrival
+// index of its clump and its `ball` its ball's global index.
+struct ClumpArrivals {
+  ClumpBodies bodies;
+  std::vector<std::uint32_t> global, pebble_global;
+  std::vector<int> owner;
+};
+
+// Clump j of `c` (every clump column) with its global index and owner, then its pebbles `list`
+// (local pebble indices, in pebble order), each with its global index, its centre in the clump's
+// frame, its radius and its ball's global index.
+void put_clump(Buffer& out, ClumpBodies& c, std::size_t j, std::uint32_t global, int owner,
+               const std::vector<std::uint32_t>& list, const std::vector<std::uint32_t>& pebble_global,
+               const std::vector<std::uint32_t>& ball_global) {
+  out.put(global);
+  out.put(owner);
+  c.for_each_clump_column([&](auto& col) { out.put(col[j]); });
+  out.put(static_cast<std::uint32_t>(list.size()));
+  for (std::uint32_t k : list) {
+    out.put(pebble_global[k]);
+    out.put(c.pebbles.body_position[k]);
+    out.put(c.pebbles.radius[k]);
+    out.put(ball_global[c.ball[k]]);
+  }
+}
+
+void get_clump(Reader& in, ClumpArrivals& a) {
+  a.global.push_back(in.get<std::uint32_t>());
+  a.owner.push_back(in.get<int>());
+  a.bodies.for_each_clump_column([&](auto& col) { col.push_back(in.get<typename std::decay_t<decltype(col)>::value_type>()); });
+  const auto j = static_cast<std::uint32_t>(a.global.size() - 1);
+  const auto n = in.get<std::uint32_t>();
+  ClumpBodies& c = a.bodies;
+  for (std::uint32_t k = 0; k < n; ++k) {
+    a.pebble_global.push_back(in.get<std::uint32_t>());
+    c.pebbles.clump.push_back(j);
+    c.pebbles.body_position.push_back(in.get<Vec3>());
+    c.pebbles.radius.push_back(in.get<double>());
+    c.ball.push_back(in.get<std::uint32_t>());
+  }
+}
+
+// Each pebble of every local clump, in pebble order, by clump.
+std::vector<std::vector<std::uint32_t>> pebbles_by_clump(const ClumpBodies& c) {
+  std::vector<std::vector<std::uint32_t>> of(c.size());
+  for (std::size_t k = 0; k < c.pebbles.size(); ++k) of[c.pebbles.clump[k]].push_back(static_cast<std::uint32_t>(k));
+  return of;
+}
+
+template <class T>
+void permute_column(std::vector<T>& col, const std::vector<std::uint32_t>& order) {
+  std::vector<T> from = std::move(col);
+  col.resize(order.size());
+  for (std::size_t k = 0; k < order.size(); ++k) col[k] = from[order[k]];
+}
+
+std::vector<std::uint32_t> ascending(const std::vector<std::uint32_t>& key, const char* what) {
+  std::vector<std::uint32_t> order(key.size());
+  std::iota(order.begin(), order.end(), 0u);
+  std::sort(order.begin(), order.end(), [&](std::uint32_t x, std::uint32_t y) { return key[x] < key[y]; });
+  for (std::size_t k = 1; k < order.size(); ++k)
+    if (key[order[k]] == key[order[k - 1]]) throw std::runtime_error(std::string("domain exchange: ") + what + " arrived twice");
+  return order;
+}
+
+// Arrived clumps made into the clumps of a Simulation: clumps by global index, pebbles by global
+// index (the whole run's orders), each pebble's ball row its ball's local index among the sorted
+// `ball_global` (or left global: gather, where the whole run's rows are the global indices).
+ClumpBodies sort_clumps(ClumpArrivals& a, const std::vector<std::uint32_t>* ball_global) {
+  ClumpBodies& c = a.bodies;
+  const std::vector<std::uint32_t> order = ascending(a.global, "a clump");
+  c.for_each_clump_column([&](auto& col) { permute_column(col, order); });
+  permute_column(a.global, order);
+  permute_column(a.owner, order);
+  std::vector<std::uint32_t> new_index(order.size());
+  for (std::size_t k = 0; k < order.size(); ++k) new_index[order[k]] = static_cast<std::uint32_t>(k);
+  const std::vector<std::uint32_t> pebble_order = ascending(a.pebble_global, "a pebble");
+  permute_column(c.pebbles.clump, pebble_order);
+  permute_column(c.pebbles.body_position, pebble_order);
+  permute_column(c.pebbles.radius, pebble_order);
+  permute_column(c.ball, pebble_order);
+  permute_column(a.pebble_global, pebble_order);
+  for (std::uint32_t& j : c.pebbles.clump) j = new_index[j];
+  if (ball_global)
+    for (std::uint32_t& b : c.ball) b = local_of(*ball_global, b);
+  return std::move(c);
+}
+
 }  // namespace
 
-Domain::Domain(MPI_Comm comm, Simulation& sim, double min_reach) : comm_(comm), min_reach_(min_reach), sim_(&sim) {
+Domain::Domain(MPI_Comm comm, Simulation& sim, double min_reach) : comm_(comm), sim_(&sim), min_reach_(min_reach) {
   MPI_Comm_rank(comm_, &rank_);
   MPI_Comm_size(comm_, &size_);
-  if (size_ > 1 && !sim.clumps.empty())
-    throw InputError("clumps are not decomposed over MPI ranks yet (docs/mpi.md): run on one rank");
   // The cycle state of a run that has cycled (a restored checkpoint), kept below.
   CycleState cycled = sim.cycle_state();
   const bool keep_cycle = !cycled.rebuild_needed && cycled.position_at_build.size() == sim.balls.size();
@@ -174,32 +268,47 @@ Domain::Domain(MPI_Comm comm, Simulation& sim, double min_reach) : comm_(comm), 
     ++bytes_.repartitions;
   }
   set_width(sim);
-  // This rank's balls (owned or ghosts) and the rows between them, in the whole run's order.
+  // This rank's balls and clumps (owned or ghosts) and the rows between its balls, in the whole
+  // run's order (through the messages' format, as if the whole run had sent them).
+  std::vector<std::vector<int>> ball_where, clump_where;
+  places(sim, ball_where, clump_where);
   BallStore balls;
   ContactStore rows;
-  std::vector<int> ranks;
   std::vector<bool> here(sim.balls.size(), false);
+  Buffer b;
   for (std::size_t i = 0; i < sim.balls.size(); ++i) {
-    ranks.clear();
-    ranks_of(sim.balls.position[i], ranks);
-    if (std::find(ranks.begin(), ranks.end(), rank_) == ranks.end()) continue;
+    const std::vector<int>& w = ball_where[i];
+    if (std::find(w.begin(), w.end(), rank_) == w.end()) continue;
     here[i] = true;
-    Buffer b;
-    put_ball(b, sim.balls, i, static_cast<std::uint32_t>(i), ranks.front());
-    Reader in{b.bytes.data(), b.bytes.data() + b.bytes.size()};
-    get_ball(in, balls, global_, owner_);
+    put_ball(b, sim.balls, i, static_cast<std::uint32_t>(i), w.front());
+  }
+  std::vector<std::uint32_t> identity(std::max(sim.balls.size(), sim.clumps.pebbles.size()));
+  std::iota(identity.begin(), identity.end(), 0u);
+  const std::vector<std::vector<std::uint32_t>> pebbles_of = pebbles_by_clump(sim.clumps);
+  Buffer cb;
+  for (std::size_t j = 0; j < sim.clumps.size(); ++j) {
+    const std::vector<int>& w = clump_where[j];
+    if (std::find(w.begin(), w.end(), rank_) == w.end()) continue;
+    put_clump(cb, sim.clumps, j, static_cast<std::uint32_t>(j), w.front(), pebbles_of[j], identity, identity);
   }
   for (std::size_t c = 0; c < sim.contacts.size(); ++c) {
     const ContactKey& k = sim.contacts.key[c];
     if (!here[k.a] || (k.kind == ContactKind::BallBall && !here[k.b])) continue;
-    Buffer b;
-    put_row(b, sim.contacts, c, k);
-    Reader in{b.bytes.data(), b.bytes.data() + b.bytes.size()};
+    Buffer rb;
+    put_row(rb, sim.contacts, c, k);
+    Reader in{rb.bytes.data(), rb.bytes.data() + rb.bytes.size()};
     get_row(in, rows);
   }
+  for (Reader in{b.bytes.data(), b.bytes.data() + b.bytes.size()}; in.p < in.end;) get_ball(in, balls, global_, owner_);
+  ClumpArrivals clumps;
+  for (Reader in{cb.bytes.data(), cb.bytes.data() + cb.bytes.size()}; in.p < in.end;) get_clump(in, clumps);
   sort_balls(balls, global_, owner_);  // (in order already: this makes the user-id index)
   sim.contacts = sort_rows(rows, &global_);
   sim.balls = std::move(balls);
+  sim.clumps = sort_clumps(clumps, &global_);
+  clump_global_ = std::move(clumps.global);
+  clump_owner_ = std::move(clumps.owner);
+  pebble_global_ = std::move(clumps.pebble_global);
   make_lists(sim);
   sim.domain = this;  // (unless kept below, the list no longer fits the balls: the next force pass detects afresh)
   if (keep_cycle) {
@@ -220,72 +329,117 @@ std::size_t Domain::owned() const {
   return static_cast<std::size_t>(std::count(owner_.begin(), owner_.end(), rank_));
 }
 
+std::size_t Domain::owned_clumps() const {
+  return static_cast<std::size_t>(std::count(clump_owner_.begin(), clump_owner_.end(), rank_));
+}
+
 std::int64_t Domain::local_of(std::uint32_t global) const {
   const auto it = std::lower_bound(global_.begin(), global_.end(), global);
   return it != global_.end() && *it == global ? it - global_.begin() : -1;
 }
 
 void Domain::set_width(const Simulation& sim) {
-  // The largest radius, and the largest gap [m] of an existing ball-ball row: wet contacts outlive
-  // the reach (the rebuild's merge keeps them, spec §2.7), and the owner of a row's first ball must
-  // hold its second to go on computing it.
-  double r[2] = {0.0, std::max(sim.settings.proximity, min_reach_)};
+  // The largest radius, the largest gap [m] of an existing ball-ball row (wet contacts outlive the
+  // reach: the rebuild's merge keeps them, spec §2.7, and the owner of a row's first ball must hold
+  // its second to go on computing it), and the largest pebble offset from its centre of mass.
+  double r[3] = {0.0, std::max(sim.settings.proximity, min_reach_), 0.0};
   for (double x : sim.balls.radius) r[0] = std::max(r[0], x);
   for (std::size_t c = 0; c < sim.contacts.size(); ++c)
     if (sim.contacts.exists[c] && sim.contacts.key[c].kind == ContactKind::BallBall) {
       const ContactGeometry g = sim.geometry(c);
       if (g.valid) r[1] = std::max(r[1], g.gap);
     }
-  MPI_Allreduce(MPI_IN_PLACE, r, 2, MPI_DOUBLE, MPI_MAX, comm_);
-  width_ = r[1] + sim.skin() + 2.0 * r[0];
+  for (const Vec3& p : sim.clumps.pebbles.body_position) r[2] = std::max(r[2], norm(p));
+  MPI_Allreduce(MPI_IN_PLACE, r, 3, MPI_DOUBLE, MPI_MAX, comm_);
+  // A ball owned here has its partners within reach + skin + its radius and theirs; a pebble of a
+  // clump owned here lies up to the extent outside the sub-domain.
+  extent_ = r[2];
+  width_ = r[1] + sim.skin() + 2.0 * r[0] + extent_;
 }
 
-void Domain::ranks_of(const Vec3& x, std::vector<int>& out) const {
+void Domain::ranks_of(const Vec3& x, double width, std::vector<int>& out) const {
   const Vec3 w = sim_->settings.box.wrapped(x);
   const int owner = rcb_->owner(w);
   out.push_back(owner);
-  rcb_->near(w, width_, sim_->settings.box, owner, out);
+  rcb_->near(w, width, sim_->settings.box, owner, out);
+}
+
+void Domain::places(const Simulation& sim, std::vector<std::vector<int>>& balls,
+                    std::vector<std::vector<int>>& clumps) const {
+  const std::size_t n = sim.balls.size();
+  clumps.assign(sim.clumps.size(), {});
+  for (std::size_t j = 0; j < sim.clumps.size(); ++j) ranks_of(sim.clumps.state.position[j], width_ + extent_, clumps[j]);
+  const std::vector<std::uint32_t> clump_of = sim.clumps.clump_of_balls(n);
+  balls.assign(n, {});
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!clump_of.empty() && clump_of[i] != kNoClump)
+      balls[i] = clumps[clump_of[i]];  // (whole: a pebble goes where its clump goes)
+    else
+      ranks_of(sim.balls.position[i], width_, balls[i]);
+  }
 }
 
 void Domain::make_lists(const Simulation& sim) {
-  send_.assign(static_cast<std::size_t>(size_), {});
-  recv_.assign(static_cast<std::size_t>(size_), {});
-  std::vector<int> ranks;
-  for (std::size_t i = 0; i < global_.size(); ++i) {
-    if (owner_[i] != rank_) {
-      recv_[static_cast<std::size_t>(owner_[i])].push_back(static_cast<std::uint32_t>(i));
-      continue;
+  std::vector<std::vector<int>> ball_where, clump_where;
+  places(sim, ball_where, clump_where);
+  // (A pebble's motion goes as its clump's state: not in the balls' lists.)
+  const std::vector<std::uint32_t> clump_of = sim.clumps.clump_of_balls(sim.balls.size());
+  auto lists = [&](const std::vector<int>& owner, const std::vector<std::vector<int>>& where, const std::vector<std::uint32_t>& skip,
+                   std::vector<std::vector<std::uint32_t>>& send, std::vector<std::vector<std::uint32_t>>& recv) {
+    send.assign(static_cast<std::size_t>(size_), {});
+    recv.assign(static_cast<std::size_t>(size_), {});
+    for (std::size_t i = 0; i < owner.size(); ++i) {
+      if (!skip.empty() && skip[i] != kNoClump) continue;
+      if (owner[i] != rank_) {
+        recv[static_cast<std::size_t>(owner[i])].push_back(static_cast<std::uint32_t>(i));
+        continue;
+      }
+      for (std::size_t k = 1; k < where[i].size(); ++k) send[static_cast<std::size_t>(where[i][k])].push_back(static_cast<std::uint32_t>(i));
     }
-    ranks.clear();
-    ranks_of(sim.balls.position[i], ranks);
-    for (std::size_t k = 1; k < ranks.size(); ++k) send_[static_cast<std::size_t>(ranks[k])].push_back(static_cast<std::uint32_t>(i));
-  }
+  };
+  lists(owner_, ball_where, clump_of, send_, recv_);
+  lists(clump_owner_, clump_where, {}, clump_send_, clump_recv_);
+  pebbles_of_ = pebbles_by_clump(sim.clumps);
 }
 
 void Domain::after_motion(Simulation& sim) {
   // Position, velocity and spin: what the force pass and the next motion read of a ball that can
-  // change within a step (9 doubles a ghost).
-  constexpr int kDoubles = 9;
+  // change within a step (9 doubles a ghost); then a ghost clump's state (16 doubles: centre of mass,
+  // velocity, orientation, spin, body-frame momentum), from which its pebbles are placed here as
+  // its owner placed them: every copy of a clump and of its pebbles is its owner's, bitwise.
+  constexpr int kDoubles = 9, kClumpDoubles = 16;
+  ClumpState& cs = sim.clumps.state;
   std::vector<std::vector<double>> out(static_cast<std::size_t>(size_)), in(static_cast<std::size_t>(size_));
   std::vector<MPI_Request> requests;
   for (int q = 0; q < size_; ++q) {
-    const auto& list = recv_[static_cast<std::size_t>(q)];
-    if (list.empty()) continue;
-    in[q].resize(list.size() * kDoubles);
+    const std::size_t count = recv_[static_cast<std::size_t>(q)].size() * kDoubles +
+                              clump_recv_[static_cast<std::size_t>(q)].size() * kClumpDoubles;
+    if (count == 0) continue;
+    in[q].resize(count);
     requests.emplace_back();
     MPI_Irecv(in[q].data(), static_cast<int>(in[q].size()), MPI_DOUBLE, q, 7, comm_, &requests.back());
   }
+  auto put3 = [](std::vector<double>& o, const Vec3& v) {
+    o.push_back(v.x);
+    o.push_back(v.y);
+    o.push_back(v.z);
+  };
   for (int q = 0; q < size_; ++q) {
     const auto& list = send_[static_cast<std::size_t>(q)];
-    if (list.empty()) continue;
+    const auto& clumps = clump_send_[static_cast<std::size_t>(q)];
+    if (list.empty() && clumps.empty()) continue;
     std::vector<double>& o = out[q];
-    o.reserve(list.size() * kDoubles);
+    o.reserve(list.size() * kDoubles + clumps.size() * kClumpDoubles);
     for (std::uint32_t i : list)
-      for (const Vec3* v : {&sim.balls.position[i], &sim.balls.velocity[i], &sim.balls.spin[i]}) {
-        o.push_back(v->x);
-        o.push_back(v->y);
-        o.push_back(v->z);
-      }
+      for (const Vec3* v : {&sim.balls.position[i], &sim.balls.velocity[i], &sim.balls.spin[i]}) put3(o, *v);
+    for (std::uint32_t j : clumps) {
+      put3(o, cs.position[j]);
+      put3(o, cs.velocity[j]);
+      const Quat& r = cs.orientation[j];
+      for (double x : {r.w, r.x, r.y, r.z}) o.push_back(x);
+      put3(o, cs.spin[j]);
+      put3(o, cs.body_momentum[j]);
+    }
     requests.emplace_back();
     MPI_Isend(o.data(), static_cast<int>(o.size()), MPI_DOUBLE, q, 7, comm_, &requests.back());
     bytes_.ghost += o.size() * sizeof(double);
@@ -293,11 +447,22 @@ void Domain::after_motion(Simulation& sim) {
   MPI_Waitall(static_cast<int>(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
   for (int q = 0; q < size_; ++q) {
     const double* p = in[q].data();
+    auto get3 = [&p]() {
+      const Vec3 v{p[0], p[1], p[2]};
+      p += 3;
+      return v;
+    };
     for (std::uint32_t i : recv_[static_cast<std::size_t>(q)])
-      for (Vec3* v : {&sim.balls.position[i], &sim.balls.velocity[i], &sim.balls.spin[i]}) {
-        *v = {p[0], p[1], p[2]};
-        p += 3;
-      }
+      for (Vec3* v : {&sim.balls.position[i], &sim.balls.velocity[i], &sim.balls.spin[i]}) *v = get3();
+    for (std::uint32_t j : clump_recv_[static_cast<std::size_t>(q)]) {
+      cs.position[j] = get3();
+      cs.velocity[j] = get3();
+      cs.orientation[j] = {p[0], p[1], p[2], p[3]};
+      p += 4;
+      cs.spin[j] = get3();
+      cs.body_momentum[j] = get3();
+      for (std::uint32_t k : pebbles_of_[j]) sim.clumps.place_pebble(sim.balls, k);
+    }
   }
   ++bytes_.steps;
 }
@@ -335,22 +500,28 @@ void Domain::before_rebuild(Simulation& sim) {
     ++bytes_.repartitions;
   }
   set_width(sim);
-  // Where each local ball is to be: its new owner, then its ghost ranks (sorted after the first).
-  std::vector<std::vector<int>> where(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    ranks_of(sim.balls.position[i], where[i]);
-    std::sort(where[i].begin() + 1, where[i].end());
-  }
+  // Where each local ball and clump is to be: its new owner, then its ghost ranks (sorted).
+  std::vector<std::vector<int>> where, clump_where;
+  places(sim, where, clump_where);
   std::vector<Buffer> out(static_cast<std::size_t>(size_));
-  // Balls from their old owner to every rank that is to hold them; rows from the old owner of their
-  // first ball to every rank that is to hold both balls. Balls first, then a marker, then rows.
+  // Balls and clumps from their old owner to every rank that is to hold them; rows from the old
+  // owner of their first ball to every rank that is to hold both balls. Balls, a marker, clumps, a
+  // marker, then rows.
   std::vector<std::vector<std::uint32_t>> row_lists(static_cast<std::size_t>(size_));
   for (std::size_t i = 0; i < n; ++i) {
     if (owner_[i] != rank_) continue;
     for (int q : where[i]) put_ball(out[static_cast<std::size_t>(q)], sim.balls, i, global_[i], where[i].front());
   }
+  for (Buffer& b : out) b.put(std::uint32_t{UINT32_MAX});  // (no global index is this: the end of the balls)
+  const std::vector<std::vector<std::uint32_t>> pebbles_of = pebbles_by_clump(sim.clumps);
+  for (std::size_t j = 0; j < sim.clumps.size(); ++j) {
+    if (clump_owner_[j] != rank_) continue;
+    for (int q : clump_where[j])
+      put_clump(out[static_cast<std::size_t>(q)], sim.clumps, j, clump_global_[j], clump_where[j].front(), pebbles_of[j],
+                pebble_global_, global_);
+  }
   std::vector<int> both;
-  auto sorted = [](std::vector<int> v) {
+  auto sorted = [](std::vector<int> v) {  // (the owner first, the others sorted: all sorted)
     std::sort(v.begin(), v.end());
     return v;
   };
@@ -361,14 +532,13 @@ void Domain::before_rebuild(Simulation& sim) {
     if (k.kind == ContactKind::BallBall) {
       const std::vector<int> wa = sorted(where[k.a]), wb = sorted(where[k.b]);
       std::set_intersection(wa.begin(), wa.end(), wb.begin(), wb.end(), std::back_inserter(both));
-    } else {
+    } else
       both = where[k.a];
-    }
     for (int q : both) row_lists[static_cast<std::size_t>(q)].push_back(static_cast<std::uint32_t>(c));
   }
   for (int q = 0; q < size_; ++q) {
     Buffer& b = out[static_cast<std::size_t>(q)];
-    b.put(std::uint32_t{UINT32_MAX});  // (no global index is this: the end of the balls)
+    b.put(std::uint32_t{UINT32_MAX});  // (the end of the clumps)
     for (std::uint32_t c : row_lists[static_cast<std::size_t>(q)]) {
       ContactKey g = rows.key[c];
       g.a = global_[g.a];
@@ -379,25 +549,24 @@ void Domain::before_rebuild(Simulation& sim) {
   const Received got = all_to_all(comm_, out, bytes_.migration);
   BallStore balls;
   ContactStore arrived;
+  ClumpArrivals clumps;
   std::vector<std::uint32_t> global;
   std::vector<int> owner;
   for (int q = 0; q < size_; ++q) {
     Reader in{got.bytes.data() + got.from[q], got.bytes.data() + got.from[q + 1]};
-    while (true) {
-      Reader peek = in;
-      if (peek.get<std::uint32_t>() == UINT32_MAX) {
-        in = peek;
-        break;
-      }
-      get_ball(in, balls, global, owner);
-    }
+    while (!at_marker(in)) get_ball(in, balls, global, owner);
+    while (!at_marker(in)) get_clump(in, clumps);
     while (in.p < in.end) get_row(in, arrived);
   }
   sort_balls(balls, global, owner);
   sim.contacts = sort_rows(arrived, &global);
   sim.balls = std::move(balls);
+  sim.clumps = sort_clumps(clumps, &global);
   global_ = std::move(global);
   owner_ = std::move(owner);
+  clump_global_ = std::move(clumps.global);
+  clump_owner_ = std::move(clumps.owner);
+  pebble_global_ = std::move(clumps.pebble_global);
   make_lists(sim);
   ++bytes_.rebuilds;
 }
@@ -457,6 +626,11 @@ Simulation Domain::gather(bool with_cycle) const {
       put_ball(b, balls, i, global_[i], rank_);
       if (built) b.put(cycle.position_at_build[i]);
     }
+  auto& clumps = const_cast<ClumpBodies&>(sim.clumps);
+  const std::vector<std::vector<std::uint32_t>> pebbles_of = pebbles_by_clump(clumps);
+  b.put(static_cast<std::uint32_t>(owned_clumps()));
+  for (std::size_t j = 0; j < clumps.size(); ++j)
+    if (clump_owner_[j] == rank_) put_clump(b, clumps, j, clump_global_[j], rank_, pebbles_of[j], pebble_global_, global_);
   for (std::size_t c = 0; c < rows.size(); ++c) {
     ContactKey g = rows.key[c];
     if (owner_[g.a] != rank_) continue;
@@ -483,6 +657,7 @@ Simulation Domain::gather(bool with_cycle) const {
   std::vector<std::uint32_t> global;
   std::vector<int> owner;
   ContactStore arrived;
+  ClumpArrivals arrived_clumps;
   bool all_built = with_cycle;
   std::vector<Vec3> at_build;  // (in arrival order, as the balls)
   for (int q = 0; q < size_; ++q) {
@@ -494,6 +669,8 @@ Simulation Domain::gather(bool with_cycle) const {
       get_ball(in, whole.balls, global, owner);
       if (built_there) at_build.push_back(in.get<Vec3>());
     }
+    const auto clumps_here = in.get<std::uint32_t>();
+    for (std::uint32_t k = 0; k < clumps_here; ++k) get_clump(in, arrived_clumps);
     while (in.p < in.end) get_row(in, arrived);
   }
   std::vector<std::uint32_t> arrival = global;  // (global indices in arrival order)
@@ -501,6 +678,12 @@ Simulation Domain::gather(bool with_cycle) const {
   for (std::size_t k = 0; k < global.size(); ++k)
     if (global[k] != k) throw std::runtime_error("domain gather: ball " + std::to_string(k) + " is missing");
   whole.contacts = sort_rows(arrived, nullptr);
+  // (The balls' rows are their global indices now: the pebbles' ball rows stay as sent.)
+  whole.clumps = sort_clumps(arrived_clumps, nullptr);
+  for (std::size_t k = 0; k < arrived_clumps.global.size(); ++k)
+    if (arrived_clumps.global[k] != k) throw std::runtime_error("domain gather: clump " + std::to_string(k) + " is missing");
+  for (std::size_t k = 0; k < arrived_clumps.pebble_global.size(); ++k)
+    if (arrived_clumps.pebble_global[k] != k) throw std::runtime_error("domain gather: pebble " + std::to_string(k) + " is missing");
   // The walls' sums as the whole run's force pass makes them: every active wall row, in row order.
   for (Wall& w : whole.walls.walls) clear_wall_sums(w);
   for (std::size_t c = 0; c < whole.contacts.size(); ++c) {

@@ -16,6 +16,13 @@
 // will hold both its balls, with its history (the pattern of LAMMPS's fix neigh/history). The
 // sub-domains are cut again by Zoltan RCB, weighted by rows per ball, when the rows per rank are out
 // of balance by more than kImbalance.
+//
+// Clumps (docs/mpi.md, "Clumps over ranks"): a clump is owned by the rank whose sub-domain holds its
+// centre of mass, and held whole (its state and every pebble) by each rank it comes near, in the
+// whole run's clump and pebble order; its pebbles are balls with its owner and its ranks. The owner
+// has every row of every pebble, so it sums the clump's loads as the whole run does; after the law
+// of motion it sends the clump's state (16 doubles) to the ranks that ghost it, which place its
+// pebbles from it: every copy is bitwise the owner's.
 #pragma once
 
 #include <cstdint>
@@ -45,7 +52,7 @@ class Domain final : public DomainHooks {
   // Make `sim`, the whole run (the same on every rank: balls, walls, rows), this rank's part, and
   // attach to it (sim.domain). A run that has cycled (its neighbour list built: a restored
   // checkpoint) keeps its cycle state, each rank the positions at the last rebuild of its balls, so
-  // that it rebuilds when the whole run would. Throws InputError for clumps over more than one rank. sim must stay where it is while attached; a Simulation that outlives
+  // that it rebuilds when the whole run would. sim must stay where it is while attached; a Simulation that outlives
   // its Domain is detached by setting sim.domain = nullptr (the destructor does not touch sim).
   // min_reach [m]: the ghosts cover pairs this far apart beyond their radii (make_wet's gap), as they
   // do the normal reach (proximity) and every existing row's gap.
@@ -78,9 +85,14 @@ class Domain final : public DomainHooks {
   // hold it (a binary search: local order is global order).
   std::int64_t local_of(std::uint32_t global) const;
   std::size_t ghosts() const { return global_.size() - owned(); }
-  // The ghost layer's width [m]: the reach (the largest of proximity, min_reach and every existing
-  // row's gap, + skin) + twice the largest radius.
+  // The ghost layer's width [m] for balls: the reach (the largest of proximity, min_reach and every
+  // existing row's gap, + skin) + twice the largest radius + clump_extent() (a pebble of a clump
+  // owned here lies that far outside the sub-domain). A clump is held where its centre of mass comes
+  // within ghost_width() + clump_extent(): then any of its pebbles within ghost_width() is.
   double ghost_width() const { return width_; }
+  // The largest distance [m] of a pebble's centre from its clump's centre of mass (0 without clumps).
+  double clump_extent() const { return extent_; }
+  std::size_t owned_clumps() const;
   const ExchangeBytes& bytes() const { return bytes_; }
 
  private:
@@ -91,18 +103,29 @@ class Domain final : public DomainHooks {
   double skin_given_ = 0.0;          // the scenario's skin (0: from the radii, fixed at the attach)
   std::unique_ptr<RcbPartition> rcb_;
   double width_ = 0.0;               // [m]
+  double extent_ = 0.0;              // [m] (clump_extent)
   std::vector<std::uint32_t> global_;  // per local ball: its global index (ascending)
   std::vector<int> owner_;             // per local ball: its owner's rank
   // after_motion's lists: per rank, the local balls sent (owned here, ghosted there) and received.
   std::vector<std::vector<std::uint32_t>> send_, recv_;
+  // The same for clumps: per local clump its global index (ascending) and owner, per local pebble
+  // its global index (ascending); after_motion's clump lists.
+  std::vector<std::uint32_t> clump_global_, pebble_global_;
+  std::vector<int> clump_owner_;
+  std::vector<std::vector<std::uint32_t>> clump_send_, clump_recv_;
+  std::vector<std::vector<std::uint32_t>> pebbles_of_;  // per local clump, its pebbles
   ExchangeBytes bytes_;
   std::vector<char> wall_in_;  // after_forces: every rank's shares
 
   void set_width(const Simulation& sim);
   void cut(const Simulation& sim, bool weighted);
-  // Every rank that is to hold the ball at x [m] (position as in the columns): its owner first, then
-  // its ghost ranks, sorted.
-  void ranks_of(const Vec3& x, std::vector<int>& out) const;
+  // Every rank that is to hold a body at x [m] (position as in the columns) as far as `width` [m]:
+  // its owner first, then its ghost ranks, sorted.
+  void ranks_of(const Vec3& x, double width, std::vector<int>& out) const;
+  // The same for each of sim's balls and clumps: a ball that is not a pebble by its position and
+  // ghost_width(), a clump by its centre of mass and ghost_width() + clump_extent(), a pebble where
+  // its clump is.
+  void places(const Simulation& sim, std::vector<std::vector<int>>& balls, std::vector<std::vector<int>>& clumps) const;
   void make_lists(const Simulation& sim);
 };
 
