@@ -155,8 +155,6 @@ int run(const Options& o) {
   const bool root = !ranks || ranks->rank() == 0;
   auto [settings, cases] = build(o);  // throws InputError (exit 2) before anything is written
   settings.genesis.ranks = ranks.get();
-  if (ranks && !settings.genesis.clump_mix.empty())
-    throw InputError("--clump-template: a lab specimen of clumps does not run over MPI ranks yet (docs/mpi.md): run it without mpirun");
   // The folder is this process's while it runs (io/output_folder.hpp); an unwritable one is bad input.
   const OutputLock lock = lab_output_lock(settings.output_dir, ranks.get());
   settings.genesis.interrupt = lab_stop_check(ranks.get());

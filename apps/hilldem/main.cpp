@@ -29,6 +29,11 @@ int run_failed(int status) { return status; }
 #endif
 }  // namespace
 
+namespace {
+// The command's status, its errors reported (input errors once, from rank 0).
+int dispatch(const hilldem::cli::Command& c);
+}  // namespace
+
 int main(int argc, char** argv) {
   hilldem::cli::set_openmp_spin(argv);
 #ifdef HILLDEM_MPI
@@ -60,17 +65,29 @@ int main(int argc, char** argv) {
     return 2;
   }
 
-  try {
-    for (const Command& c : commands)
-      if (c.sub && *c.sub) {
+  for (const Command& c : commands)
+    if (c.sub && *c.sub) {
 #ifdef HILLDEM_MPI
-        const std::string name = c.sub->get_name();
-        if (g_size > 1 && name != "bench" && name != "run" && name != "resume" && name != "triaxial" && name != "t307")
-          throw hilldem::InputError("'" + name + "' does not run decomposed over MPI ranks yet (only 'bench', 'run', "
-                                    "'resume', 'triaxial' and 't307' do, docs/mpi.md): run it without mpirun, or with -np 1");
-#endif
-        return c.run();
+      // The commands that are not decomposed (check, contacts, quantities, verify, inspect: small or
+      // reading one file) run on rank 0 alone; the other ranks wait for it and end with its status.
+      const std::string name = c.sub->get_name();
+      const bool decomposed = name == "bench" || name == "run" || name == "resume" || name == "triaxial" || name == "t307";
+      if (g_size > 1 && !decomposed) {
+        int status = g_rank == 0 ? dispatch(c) : 0;
+        MPI_Bcast(&status, 1, MPI_INT, 0, hilldem::parallel::world());
+        return status;
       }
+#endif
+      return dispatch(c);
+    }
+  return 0;
+}
+
+namespace {
+
+int dispatch(const hilldem::cli::Command& c) {
+  try {
+    return c.run();
   } catch (const hilldem::InputError& e) {
     if (!quiet_rank()) std::cerr << "hilldem: error: " << e.what() << "\n";
     return 2;
@@ -84,5 +101,6 @@ int main(int argc, char** argv) {
     std::cerr << "hilldem: error" << rank_tag() << ": " << e.what() << "\n";
     return run_failed(1);
   }
-  return 0;
 }
+
+}  // namespace

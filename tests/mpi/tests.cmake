@@ -87,8 +87,12 @@ foreach(ranks 1 2 3 4)
   set_tests_properties(mpi.lab_commands_${ranks}_ranks PROPERTIES TIMEOUT 600 LABELS mpi
     ENVIRONMENT "OMP_NUM_THREADS=1;MPIRUN=${HILLDEM_MPIRUN_LINE}")
 endforeach()
-# Commands that do not run decomposed yet say so once, with exit status 2.
-add_test(NAME mpi.run_on_two_ranks_exits_2
-  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "does not run decomposed"
-          2 ${HILLDEM_MPIRUN} -np 2 $<TARGET_FILE:hilldem> check ${PROJECT_SOURCE_DIR}/examples/assembly_27.toml)
-set_tests_properties(mpi.run_on_two_ranks_exits_2 PROPERTIES TIMEOUT 120 LABELS mpi)
+# Commands that are not decomposed run on rank 0 alone, and every rank ends with its status.
+add_test(NAME mpi.check_on_two_ranks_runs_on_rank_0
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stdout "assembly_27.toml: valid (27 balls"
+          0 ${HILLDEM_MPIRUN} -np 2 $<TARGET_FILE:hilldem> check ${PROJECT_SOURCE_DIR}/examples/assembly_27.toml)
+add_test(NAME mpi.check_of_a_missing_file_on_two_ranks_exits_2
+  COMMAND ${HILLDEM_EXPECT_EXIT} --stderr "cannot open the scenario file"
+          2 ${HILLDEM_MPIRUN} -np 2 $<TARGET_FILE:hilldem> check ${PROJECT_SOURCE_DIR}/examples/no_such_file.toml)
+set_tests_properties(mpi.check_on_two_ranks_runs_on_rank_0 mpi.check_of_a_missing_file_on_two_ranks_exits_2
+  PROPERTIES TIMEOUT 120 LABELS mpi)

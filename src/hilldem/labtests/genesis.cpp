@@ -254,10 +254,6 @@ bool is_root(const Specimen& s) { return !s.ranks || s.ranks->rank() == 0; }
 
 void attach_to_ranks(Specimen& s, double reach) {
   if (!s.ranks || s.sim.domain) return;
-  // The drivers' readings over ranks (a row counted by the owner of its first ball, the velocity cap
-  // of the cloud relaxation on ghost clumps) are made and tested for balls only: refused on one rank too.
-  if (!s.sim.clumps.empty())
-    throw InputError("a lab specimen of clumps does not run over MPI ranks yet (docs/mpi.md): run it without mpirun");
   // Taken here, on the whole run: a rank's balls (owned and ghosts) are not the grains.
   s.whole_grains = grain_count(s.sim);
   s.whole_solid = solid_volume(s.sim);
@@ -511,16 +507,17 @@ PhaseReport relax_cloud(Specimen& s, const PackingSettings& p, std::ostream* log
   const double cap = p.cloud_speed_limit;
   // A clump's speed is capped at its centre of mass, and its spin so that no point of it within its
   // enclosing radius moves faster than the cap from the turn (ω and L_b scaled together: ω = R I⁻¹ L_b).
-  std::vector<double> reach(sim.clumps.size(), 0.0);
-  for (std::size_t k = 0; k < sim.clumps.pebbles.size(); ++k) {
-    double& x = reach[sim.clumps.pebbles.clump[k]];
-    x = std::max(x, norm(sim.clumps.pebbles.body_position[k]) + sim.clumps.pebbles.radius[k]);
-  }
+  // The radii from the clumps held at each step: over MPI ranks they change with every migration.
   ControllerScope scope(sim);
-  sim.controllers.push_back([cap, reach](Simulation& m, double) {
+  sim.controllers.push_back([cap, reach = std::vector<double>()](Simulation& m, double) mutable {
     for (Vec3& v : m.balls.velocity) {
       const double speed = norm(v);
       if (speed > cap) v *= cap / speed;
+    }
+    reach.assign(m.clumps.size(), 0.0);
+    for (std::size_t k = 0; k < m.clumps.pebbles.size(); ++k) {
+      double& x = reach[m.clumps.pebbles.clump[k]];
+      x = std::max(x, norm(m.clumps.pebbles.body_position[k]) + m.clumps.pebbles.radius[k]);
     }
     ClumpState& c = m.clumps.state;
     for (std::size_t i = 0; i < c.size(); ++i) {
