@@ -11,6 +11,7 @@
 #include "hilldem/core/error.hpp"
 #include "hilldem/bodies/clump_fill.hpp"
 #include "hilldem/bodies/clump_mesh.hpp"
+#include "hilldem/io/quantity.hpp"
 #include "hilldem/io/scenario.hpp"
 
 namespace hilldem {
@@ -127,6 +128,19 @@ position = [0.0, -0.03, 0.0]
   EXPECT_NEAR(in.x, 1e-8, 1e-20);
   EXPECT_NEAR(in.y, 2e-8, 1e-20);
   EXPECT_NEAR(in.z, 3e-8, 1e-20);
+}
+
+// A history or probe may name a pebble by its ball id (first_id, +1, ...): the history samples the
+// pebble's ball; an id past the last pebble is refused with the key.
+TEST(ClumpScenario, HistoriesNameAPebbleByItsBallId) {
+  auto history = [](int id) {
+    return "[[history]]\nname = \"p\"\nquantity = \"ball.pos_x\"\nball = " + std::to_string(id) + "\n";
+  };
+  const Scenario sc = load_scenario(kHead + kRod + kClump + history(12), "case.toml");
+  ASSERT_EQ(sc.histories.size(), 1u);
+  EXPECT_EQ(sc.histories[0].quantity.ball, 12);
+  EXPECT_EQ(evaluate(sc.sim, sc.histories[0].quantity), sc.sim.balls.position[3].x);
+  expect_error(kHead + kRod + kClump + history(13), {"history[1].ball", "no ball or pebble with id 13"});
 }
 
 TEST(ClumpScenario, ErrorsNameTheKey) {

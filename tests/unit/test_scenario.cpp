@@ -381,7 +381,7 @@ TEST(ScenarioReference, ProbeRatioToItself) {
 
 TEST(ScenarioReference, ProbeOfABallThatDoesNotExist) {
   const std::string m = input_error(replace("balls = [1, 2]", "balls = [1, 7]"));
-  EXPECT_TRUE(Mentions(m, {kFile, "key 'stage[2].balls'", "no ball with id 7"}));
+  EXPECT_TRUE(Mentions(m, {kFile, "key 'stage[2].balls'", "no ball or pebble with id 7"}));
 }
 
 TEST(ScenarioReference, RuleGroupThatDoesNotExist) {

@@ -67,7 +67,7 @@ Quantity read_quantity(TableReader& t, const SimulationDescription& sim) {
   q.unit = info->unit;
 
   auto ball_id = [&](const std::string& key, std::int64_t id) {
-    if (sim.find_ball(id) < 0) t.fail(key, "no ball with id " + std::to_string(id));
+    if (!sim.has_ball_id(id)) t.fail(key, "no ball or pebble with id " + std::to_string(id));
     return id;
   };
   auto read_walls = [&] {

@@ -8,6 +8,15 @@ long SimulationDescription::find_ball(std::int64_t id) const {
   return -1;
 }
 
+bool SimulationDescription::has_ball_id(std::int64_t id) const {
+  if (find_ball(id) >= 0) return true;
+  for (const Clump& c : clumps) {
+    const auto n = static_cast<std::int64_t>(clump_templates[c.tmpl].pebbles.size());
+    if (id >= c.init.first_ball_id && id - c.init.first_ball_id < n) return true;
+  }
+  return false;
+}
+
 std::vector<std::size_t> SimulationDescription::walls_named(const std::string& name) const {
   std::vector<std::size_t> out;
   const std::uint64_t bit = groups.find(name);

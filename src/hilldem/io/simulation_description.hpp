@@ -27,8 +27,10 @@ struct SimulationDescription {
   };
   std::vector<Clump> clumps;
 
-  // Index of the ball with user id `id`, or -1.
+  // Index of the ball with user id `id`, or -1 (the balls only: not the clumps' pebbles).
   long find_ball(std::int64_t id) const;
+  // Whether `id` is a ball's or a clump's pebble's (clump c's pebbles: first_ball_id, +1, ...).
+  bool has_ball_id(std::int64_t id) const;
   // Indices of the walls named `name` or in the group `name`, in index order.
   std::vector<std::size_t> walls_named(const std::string& name) const;
 };
