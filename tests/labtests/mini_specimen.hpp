@@ -5,6 +5,9 @@
 // Genesis.* tests pack it from the cloud themselves.
 #pragma once
 
+#include <gtest/gtest.h>
+
+#include <cstring>
 #include <filesystem>
 #include <string>
 
@@ -12,6 +15,25 @@
 #include "hilldem/labtests/study.hpp"
 
 namespace hilldem::testing {
+
+// A specimen's clumps read back (a file, a copy) are the original's to the bit: the clumps' centres,
+// orientations, masses and inertias, the pebbles' body positions and radii, and their balls' positions.
+inline void expect_same_clumps(const Simulation& a, const Simulation& b) {
+  const ClumpBodies &x = a.clumps, &y = b.clumps;
+  ASSERT_EQ(x.size(), y.size());
+  ASSERT_EQ(x.pebbles.size(), y.pebbles.size());
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    EXPECT_EQ(std::memcmp(&x.state.position[i], &y.state.position[i], sizeof(Vec3)), 0);
+    EXPECT_EQ(std::memcmp(&x.state.orientation[i], &y.state.orientation[i], sizeof(Quat)), 0);
+    EXPECT_EQ(x.state.mass[i], y.state.mass[i]);
+    EXPECT_EQ(std::memcmp(&x.state.principal_inertia[i], &y.state.principal_inertia[i], sizeof(Vec3)), 0);
+  }
+  for (std::size_t k = 0; k < x.pebbles.size(); ++k) {
+    EXPECT_EQ(std::memcmp(&x.pebbles.body_position[k], &y.pebbles.body_position[k], sizeof(Vec3)), 0);
+    EXPECT_EQ(x.pebbles.radius[k], y.pebbles.radius[k]);
+    EXPECT_EQ(std::memcmp(&a.balls.position[x.ball[k]], &b.balls.position[y.ball[k]], sizeof(Vec3)), 0);
+  }
+}
 
 inline GenesisSpec mini_spec() {
   GenesisSpec g;
